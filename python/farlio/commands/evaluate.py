@@ -1,13 +1,14 @@
-"""`farlio evaluate`: not yet available in this build."""
+"""`farlio eval`: compare a trajectory with ground truth (implementation in farlio.evaluation)."""
 from __future__ import annotations
 
 import argparse
 
+from farlio.evaluation import add_eval_arguments, run_eval
+
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    del parser
+    add_eval_arguments(parser)
 
 
 def run(args: argparse.Namespace) -> int:
-    del args
-    raise RuntimeError("this command is not implemented yet")
+    return run_eval(args)
