@@ -15,4 +15,5 @@ NB_MODULE(_core, m) {
   farlio::python::bind_sim(sim);
   auto ev = m.def_submodule("eval", "trajectory evaluation: APE, RPE, coverage");
   farlio::python::bind_eval(ev);
+  farlio::python::bind_pipeline(m);
 }
