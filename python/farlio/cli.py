@@ -11,6 +11,7 @@ import sys
 
 # name -> (module, help). Each module provides add_arguments(parser) and run(args) -> int.
 COMMANDS = {
+    "run": ("farlio.commands.run", "run the odometry over a recording and write trajectories, timings, summary"),
     "simulate": ("farlio.commands.simulate", "generate a LiDAR + IMU sequence with exact ground truth"),
     "eval": ("farlio.commands.evaluate", "compare a trajectory with ground truth (APE, RPE, coverage)"),
     "info": ("farlio.commands.info", "print the build (CUDA backend, devices) and version"),
