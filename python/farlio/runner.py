@@ -159,7 +159,7 @@ def format_summary(s: dict[str, Any]) -> str:
 
 def _accuracy_line(acc: dict[str, Any]) -> str:
     try:
-        ape = acc["ape"]["translation_aligned_m"]["rmse"]
+        ape = acc["ape"]["translation_m"]["rmse"]
         kitti = acc["kitti_rpe"]
         return (f"accuracy: APE {ape:.3f} m (aligned RMSE), RPE {kitti['translation_pct']:.3f} % / "
                 f"{kitti['rotation_deg_per_100m']:.3f} deg/100m, coverage {100 * acc['coverage']:.1f}%")
