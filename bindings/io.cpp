@@ -1,5 +1,116 @@
+// Bindings of farlio::io: point cloud files, trajectory files and the sequence folder.
+// Paths are str or os.PathLike; bad input raises farlio._core.InputError (a ValueError).
+#include <nanobind/stl/filesystem.h>
+#include <nanobind/stl/map.h>
+#include <nanobind/stl/optional.h>
+#include <nanobind/stl/string.h>
+#include <nanobind/stl/vector.h>
+
 #include "bindings.hpp"
+#include "farlio/io/calibration.hpp"
+#include "farlio/io/point_cloud_io.hpp"
+#include "farlio/io/sequence.hpp"
+#include "farlio/io/trajectory_io.hpp"
+
+namespace nb = nanobind;
+using namespace nb::literals;
 
 namespace farlio::python {
-void bind_io(nanobind::module_& /*m*/) {}  // filled in when the io module lands
+namespace {
+
+using namespace farlio::io;
+using Path = std::filesystem::path;
+
+PcdEncoding encoding_from(const std::string& name) {
+  const auto enc = parse_pcd_encoding(name);
+  if (!enc) throw nb::value_error(("unknown PCD encoding '" + name + "' (ascii, binary or binary_compressed)").c_str());
+  return *enc;
+}
+
+void bind_point_clouds(nb::module_& m) {
+  m.def("read_point_cloud", &read_point_cloud, "path"_a,
+        "Reads a .pcd/.ply/.bin file (optionally .gz) into a Scan (stamps 0).");
+  m.def(
+      "write_pcd",
+      [](const Path& path, const Scan& scan, const std::string& encoding) { write_pcd(path, scan, encoding_from(encoding)); },
+      "path"_a, "scan"_a, "encoding"_a = "binary",
+      "Writes x y z [intensity] [t] float32 [sensor_id] uint8; encoding ascii, binary or binary_compressed.");
+  m.def(
+      "write_ply",
+      [](const Path& path, const Scan& scan) {
+        write_ply(path, scan.points, scan.intensity.empty() ? nullptr : &scan.intensity);
+      },
+      "path"_a, "scan"_a, "Binary little endian PLY of the scan's points (and intensity if present).");
+  m.def("write_kitti_bin", &write_kitti_bin, "path"_a, "scan"_a, "KITTI .bin: float32 x y z intensity.");
+}
+
+void bind_trajectories(nb::module_& m) {
+  m.def("read_tum", &read_tum, "path"_a);
+  m.def("write_tum", &write_tum, "path"_a, "trajectory"_a);
+  m.def(
+      "read_kitti",
+      [](const Path& path, const std::optional<std::vector<std::int64_t>>& stamps_ns) {
+        return read_kitti(path, stamps_ns ? &*stamps_ns : nullptr);
+      },
+      "path"_a, "stamps_ns"_a = nb::none(), "KITTI 3x4 poses; without stamps pose i gets i * 100 ms.");
+  m.def("write_kitti", &write_kitti, "path"_a, "trajectory"_a);
+  nb::class_<TrajectoryWriter>(m, "TrajectoryWriter", "Appends TUM lines, flushing each one.")
+      .def(nb::init<const Path&>(), "path"_a)
+      .def("append", &TrajectoryWriter::append, "stamp_ns"_a, "pose"_a)
+      .def("__len__", &TrajectoryWriter::size)
+      .def_prop_ro("path", &TrajectoryWriter::path);
+}
+
+void bind_sequence(nb::module_& m) {
+  nb::class_<Calibration>(m, "Calibration", "calib.yaml: extrinsic, gravity, sensor rates.")
+      .def(nb::init<>())
+      .def_rw("T_imu_lidar", &Calibration::T_imu_lidar)
+      .def_rw("gravity_m_s2", &Calibration::gravity_m_s2)
+      .def_rw("imu_rate_hz", &Calibration::imu_rate_hz)
+      .def_rw("lidar_rate_hz", &Calibration::lidar_rate_hz);
+  m.def("read_calibration", &read_calibration, "path"_a);
+  m.def("write_calibration", &write_calibration, "path"_a, "calibration"_a);
+
+  nb::class_<SequenceReader>(m, "SequenceReader", "Reads a sequence folder (lidar/, imu.csv, calib.yaml, ...).")
+      .def(nb::init<Path>(), "dir"_a)
+      .def_prop_ro("dir", &SequenceReader::dir)
+      .def("num_scans", &SequenceReader::num_scans)
+      .def("__len__", &SequenceReader::num_scans)
+      .def("scan_end_stamp_ns", &SequenceReader::scan_end_stamp_ns, "i"_a)
+      .def("scan_start_stamp_ns", &SequenceReader::scan_start_stamp_ns, "i"_a)
+      .def("scan_path", &SequenceReader::scan_path, "i"_a)
+      .def("read_scan", &SequenceReader::read_scan, "i"_a)
+      .def("has_imu", &SequenceReader::has_imu)
+      .def("imu", &SequenceReader::imu, "The IMU samples (a copy).")
+      .def("has_calibration", &SequenceReader::has_calibration)
+      .def("calibration", &SequenceReader::calibration)
+      .def("groundtruth", &SequenceReader::groundtruth)
+      .def("groundtruth_scans", &SequenceReader::groundtruth_scans)
+      .def("warnings", &SequenceReader::warnings);
+
+  nb::class_<SequenceWriter>(m, "SequenceWriter", "Writes a sequence folder, one whole file per call.")
+      .def(nb::init<Path>(), "dir"_a)
+      .def_prop_ro("dir", &SequenceWriter::dir)
+      .def("write_calibration", &SequenceWriter::write_calibration, "calibration"_a)
+      .def(
+          "write_scan",
+          [](SequenceWriter& w, const Scan& scan, const std::string& encoding) { w.write_scan(scan, encoding_from(encoding)); },
+          "scan"_a, "encoding"_a = "binary")
+      .def("write_imu", &SequenceWriter::write_imu, "samples"_a)
+      .def("write_groundtruth", &SequenceWriter::write_groundtruth, "body_poses"_a)
+      .def("write_groundtruth_scans", &SequenceWriter::write_groundtruth_scans, "body_poses_at_scan_end"_a)
+      .def("write_groundtruth_kitti", &SequenceWriter::write_groundtruth_kitti, "lidar_poses_at_scan_end"_a)
+      .def("write_kitti_scan", &SequenceWriter::write_kitti_scan, "scan"_a, "index"_a)
+      .def("write_kitti_times", &SequenceWriter::write_kitti_times, "scan_stamps_ns"_a)
+      .def("write_meta", &SequenceWriter::write_meta, "meta"_a);
+}
+
+}  // namespace
+
+void bind_io(nb::module_& m) {
+  bind_point_clouds(m);
+  bind_trajectories(m);
+  bind_sequence(m);
+}
+
 }  // namespace farlio::python

@@ -1,0 +1,148 @@
+#include "farlio/io/trajectory_io.hpp"
+
+#include <array>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "farlio/core/error.hpp"
+#include "farlio/io/text_number.hpp"
+
+namespace farlio::io {
+namespace {
+
+constexpr std::size_t kTumValues = 8;    // t x y z qx qy qz qw
+constexpr std::size_t kKittiValues = 12;  // 3x4 row-major
+constexpr int kKittiRows = 3;
+constexpr int kKittiCols = 4;
+constexpr double kMinQuaternionNorm = 1e-6;
+constexpr const char* kTumHeader = "# t x y z qx qy qz qw (t in seconds)\n";
+
+std::string tum_line(std::int64_t stamp_ns, const SE3& pose) {
+  const auto& t = pose.translation();
+  const auto& q = pose.quaternion();
+  std::string s = format_seconds_from_ns(stamp_ns);
+  for (double v : {t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w()}) {
+    s += ' ';
+    s += format_number(v);
+  }
+  s += '\n';
+  return s;
+}
+
+std::ifstream open_for_reading(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path.string() + ": no such file");
+  std::ifstream in(path);
+  if (!in) throw InputError(path.string() + ": cannot open file");
+  return in;
+}
+
+void write_text(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::trunc);
+  if (!out) throw std::runtime_error(path.string() + ": cannot open for writing");
+  out << text;
+  out.flush();
+  if (!out) throw std::runtime_error(path.string() + ": write error");
+}
+
+/// Calls on_values(line_no, tokens) for every non-blank, non-comment line.
+template <class F>
+void for_each_data_line(const std::filesystem::path& path, F&& on_values) {
+  std::ifstream in = open_for_reading(path);
+  std::string line;
+  std::size_t line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    const auto t = trim(line);
+    if (t.empty() || t.front() == '#') continue;
+    on_values(line_no, split_whitespace(t));
+  }
+}
+
+[[noreturn]] void bad_line(const std::filesystem::path& path, std::size_t line_no, const std::string& what) {
+  throw InputError(path.string() + ":" + std::to_string(line_no) + ": " + what);
+}
+
+double number_at(const std::filesystem::path& path, std::size_t line_no, std::string_view tok) {
+  const auto v = parse_double(tok);
+  if (!v || !std::isfinite(*v)) bad_line(path, line_no, "'" + std::string(tok) + "' is not a finite number");
+  return *v;
+}
+
+}  // namespace
+
+Trajectory read_tum(const std::filesystem::path& path) {
+  Trajectory traj;
+  for_each_data_line(path, [&](std::size_t line_no, const std::vector<std::string_view>& tok) {
+    if (tok.size() != kTumValues) {
+      bad_line(path, line_no, "expected 8 values 't x y z qx qy qz qw', found " + std::to_string(tok.size()));
+    }
+    const auto stamp = parse_seconds_to_ns(tok[0]);
+    if (!stamp) bad_line(path, line_no, "time '" + std::string(tok[0]) + "' is not a number of seconds");
+    std::array<double, kTumValues - 1> v{};
+    for (std::size_t k = 1; k < kTumValues; ++k) v[k - 1] = number_at(path, line_no, tok[k]);
+    const Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);
+    if (q.norm() < kMinQuaternionNorm) bad_line(path, line_no, "quaternion has zero norm");
+    traj.push_back(*stamp, SE3(q, Eigen::Vector3d(v[0], v[1], v[2])));
+  });
+  return traj;
+}
+
+void write_tum(const std::filesystem::path& path, const Trajectory& trajectory) {
+  std::string text = kTumHeader;
+  for (const auto& p : trajectory) text += tum_line(p.stamp_ns, p.pose);
+  write_text(path, text);
+}
+
+Trajectory read_kitti(const std::filesystem::path& path, const std::vector<std::int64_t>* stamps_ns) {
+  std::vector<SE3> poses;
+  for_each_data_line(path, [&](std::size_t line_no, const std::vector<std::string_view>& tok) {
+    if (tok.size() != kKittiValues) {
+      bad_line(path, line_no, "expected 12 values (3x4 row-major), found " + std::to_string(tok.size()));
+    }
+    Mat4d m = Mat4d::Identity();
+    for (int r = 0; r < kKittiRows; ++r) {
+      for (int c = 0; c < kKittiCols; ++c) m(r, c) = number_at(path, line_no, tok[static_cast<std::size_t>(r * kKittiCols + c)]);
+    }
+    poses.push_back(SE3::from_matrix(m));
+  });
+  if (stamps_ns != nullptr && stamps_ns->size() != poses.size()) {
+    throw InputError(path.string() + ": " + std::to_string(poses.size()) + " poses but " +
+                     std::to_string(stamps_ns->size()) + " stamps were given");
+  }
+  Trajectory traj;
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    const std::int64_t stamp = stamps_ns ? (*stamps_ns)[i] : static_cast<std::int64_t>(i) * kKittiDefaultPeriodNs;
+    traj.push_back(stamp, poses[i]);
+  }
+  return traj;
+}
+
+void write_kitti(const std::filesystem::path& path, const Trajectory& trajectory) {
+  std::string text;
+  for (const auto& p : trajectory) {
+    const Mat4d m = p.pose.matrix();
+    for (int r = 0; r < kKittiRows; ++r) {
+      for (int c = 0; c < kKittiCols; ++c) {
+        if (r || c) text += ' ';
+        text += format_number(m(r, c));
+      }
+    }
+    text += '\n';
+  }
+  write_text(path, text);
+}
+
+TrajectoryWriter::TrajectoryWriter(const std::filesystem::path& path) : path_(path), out_(path, std::ios::trunc) {
+  if (!out_) throw std::runtime_error(path.string() + ": cannot open for writing");
+  out_ << kTumHeader << std::flush;
+}
+
+void TrajectoryWriter::append(std::int64_t stamp_ns, const SE3& pose) {
+  out_ << tum_line(stamp_ns, pose) << std::flush;
+  if (!out_) throw std::runtime_error(path_.string() + ": write error");
+  ++count_;
+}
+
+}  // namespace farlio::io

@@ -1,0 +1,119 @@
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "farlio/io/text_number.hpp"
+#include "farlio/io/trajectory_io.hpp"
+#include "io_test_util.hpp"
+#include "test_support.hpp"
+
+using namespace farlio;
+using namespace farlio::io;
+using farlio::test::TempDir;
+
+namespace {
+
+Trajectory random_trajectory(std::size_t n, unsigned seed, std::int64_t t0_ns) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> g(0.0, 1.0);
+  std::uniform_int_distribution<std::int64_t> dt(1, 200'000'000);
+  Trajectory tr;
+  std::int64_t t = t0_ns;
+  for (std::size_t i = 0; i < n; ++i) {
+    Vec6d xi;
+    for (int k = 0; k < 6; ++k) xi[k] = g(rng) * 10.0;
+    xi.tail<3>() *= 0.25;
+    tr.push_back(t, SE3::exp(xi));
+    t += dt(rng);
+  }
+  return tr;
+}
+
+void expect_same(const Trajectory& a, const Trajectory& b, bool stamps) {
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (stamps) {
+      EXPECT_EQ(a[i].stamp_ns, b[i].stamp_ns) << i;
+    }
+    EXPECT_LT((a[i].pose.translation() - b[i].pose.translation()).norm(), 1e-9) << i;
+    EXPECT_LT((a[i].pose.inverse() * b[i].pose).angle_rad(), 1e-9) << i;
+  }
+}
+
+}  // namespace
+
+TEST(TextNumber, SecondsNsExactConversion) {
+  for (std::int64_t ns : {std::int64_t{0}, std::int64_t{1}, std::int64_t{999'999'999}, std::int64_t{1'700'000'000'123'456'789},
+                          std::int64_t{-1'500'000'001}, std::int64_t{-1}}) {
+    const std::string s = format_seconds_from_ns(ns);
+    EXPECT_EQ(s.size() - s.find('.') - 1, 9u) << s;
+    EXPECT_EQ(parse_seconds_to_ns(s), ns) << s;
+  }
+  EXPECT_EQ(parse_seconds_to_ns("1.5"), 1'500'000'000);
+  EXPECT_EQ(parse_seconds_to_ns("2"), 2'000'000'000);
+  EXPECT_EQ(parse_seconds_to_ns("1e-3"), 1'000'000);
+  EXPECT_EQ(parse_seconds_to_ns("0.0000000015"), 2);  // rounds the 10th decimal
+  EXPECT_FALSE(parse_seconds_to_ns("abc"));
+  EXPECT_FALSE(parse_seconds_to_ns("1.2.3"));
+  EXPECT_FALSE(parse_seconds_to_ns("99999999999.5"));  // beyond int64 ns
+}
+
+TEST(Tum, RoundTripWithLargeStamps) {
+  TempDir tmp;
+  const auto tr = random_trajectory(200, 1, 1'700'000'000'000'000'123);
+  const auto p = tmp.path() / "a.tum";
+  write_tum(p, tr);
+  expect_same(tr, read_tum(p), true);
+}
+
+TEST(Tum, CommentsBlankLinesAndErrorsWithLineNumbers) {
+  TempDir tmp;
+  const auto p = tmp.path() / "b.tum";
+  test::write_raw(p, "# header\n\n1.0 1 2 3 0 0 0 1\n  # indented comment\n2.5 4 5 6 0 0 0.7071067811865476 0.7071067811865476\n");
+  const auto tr = read_tum(p);
+  ASSERT_EQ(tr.size(), 2u);
+  EXPECT_EQ(tr[1].stamp_ns, 2'500'000'000);
+  EXPECT_EQ(tr[1].pose.translation(), Eigen::Vector3d(4, 5, 6));
+  EXPECT_NEAR(tr[1].pose.angle_rad(), M_PI / 2, 1e-12);
+
+  test::write_raw(p, "1.0 1 2 3 0 0 0 1\n2.0 1 2 3 0 0 1\n");
+  test::expect_input_error([&] { (void)read_tum(p); }, p, "b.tum:2");
+  test::write_raw(p, "1.0 1 2 3 0 0 0 1\n\n2.0 1 x 3 0 0 0 1\n");
+  test::expect_input_error([&] { (void)read_tum(p); }, p, "b.tum:3");
+  test::write_raw(p, "1.0 1 2 3 0 0 0 0\n");
+  test::expect_input_error([&] { (void)read_tum(p); }, p, "zero norm");
+  test::expect_input_error([&] { (void)read_tum(tmp.path() / "none.tum"); }, tmp.path() / "none.tum", "no such file");
+}
+
+TEST(Kitti, RoundTripAndStamps) {
+  TempDir tmp;
+  const auto tr = random_trajectory(50, 2, 0);
+  const auto p = tmp.path() / "poses.txt";
+  write_kitti(p, tr);
+  const auto plain = read_kitti(p);
+  expect_same(tr, plain, false);
+  for (std::size_t i = 0; i < plain.size(); ++i) EXPECT_EQ(plain[i].stamp_ns, static_cast<std::int64_t>(i) * kKittiDefaultPeriodNs);
+  std::vector<std::int64_t> stamps;
+  for (const auto& sp : tr) stamps.push_back(sp.stamp_ns);
+  expect_same(tr, read_kitti(p, &stamps), true);
+  stamps.pop_back();
+  test::expect_input_error([&] { (void)read_kitti(p, &stamps); }, p, "stamps");
+  test::write_raw(p, "1 0 0 0 0 1 0 0 0 0 1\n");
+  test::expect_input_error([&] { (void)read_kitti(p); }, p, "poses.txt:1");
+}
+
+TEST(TrajectoryWriter, FlushesEveryPose) {
+  TempDir tmp;
+  const auto tr = random_trajectory(5, 3, 42);
+  const auto p = tmp.path() / "live.tum";
+  TrajectoryWriter w(p);
+  for (std::size_t i = 0; i < tr.size(); ++i) {
+    w.append(tr[i].stamp_ns, tr[i].pose);
+    // Readable while the writer is still open: every line is already on disk.
+    const auto partial = read_tum(p);
+    ASSERT_EQ(partial.size(), i + 1);
+    EXPECT_EQ(partial[i].stamp_ns, tr[i].stamp_ns);
+  }
+  EXPECT_EQ(w.size(), tr.size());
+  expect_same(tr, read_tum(p), true);
+}
