@@ -111,7 +111,7 @@ def run_dataset(dataset: Dataset, out_dir: Path, config: Any = None, *, max_fram
             rel.push_back(stamp, first_inv * pose)
         _core.io.write_kitti(out_dir / "scans_lidar_kitti.txt", rel)
     if save_map:
-        _core.io.write_ply(out_dir / "map.ply", pipe.map_points())
+        _core.io.write_ply(out_dir / "map.ply", farlio.Scan(pipe.map_points()))
 
     summary: dict[str, Any] = {
         "dataset": str(dataset.path),

@@ -16,7 +16,9 @@ struct PreprocessConfig {
 /// The voxel hash map (cuVoxelMap): the adaptive local submap and the per-scan frame map.
 struct VoxelMapConfig {
   double voxel_size_m = 4.0;           ///< v: edge of a voxel cube (paper: 4 m)
-  int max_points_per_voxel = 40;       ///< N_max (paper: 40); the spacing is sqrt(v^2 / N_max) ~ 0.63 m
+  int max_points_per_voxel = 40;       ///< N_max (paper: 40)
+  /// Minimum distance between points of a voxel; 0: sqrt(v^2 / N_max) (~0.63 m by default).
+  double point_spacing_m = 0.0;
   int covariance_neighbors = 10;       ///< k nearest neighbours for a point covariance (paper: 10)
   double covariance_epsilon = 1e-3;    ///< C = Sigma_hat + eps * I before Frobenius normalisation (eq. 1)
   double removal_radius_m = 1000.0;    ///< voxels whose centre is farther from the pose are removed

@@ -14,6 +14,7 @@ std::vector<ConfigField> config_fields(Config& c) {
       {"map.voxel_size_m", &c.map.voxel_size_m, "edge of a voxel of the submap (paper: 4 m)"},
       {"map.max_points_per_voxel", &c.map.max_points_per_voxel,
        "N_max; the point spacing is voxel_size_m / sqrt(N_max) (paper: 40)"},
+      {"map.point_spacing_m", &c.map.point_spacing_m, "minimum point distance in a voxel; 0: voxel_size_m / sqrt(N_max)"},
       {"map.covariance_neighbors", &c.map.covariance_neighbors, "k nearest neighbours of a covariance (paper: 10)"},
       {"map.covariance_epsilon", &c.map.covariance_epsilon, "eps of the Frobenius regularisation, eq. (1)"},
       {"map.removal_radius_m", &c.map.removal_radius_m, "voxels farther than this from the pose are removed"},

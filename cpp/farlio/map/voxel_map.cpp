@@ -25,10 +25,15 @@ struct GroupStats {
 };
 }  // namespace
 
+double point_spacing_m(const VoxelMapConfig& config) {
+  return config.point_spacing_m > 0.0 ? config.point_spacing_m
+                                      : config.voxel_size_m / std::sqrt(static_cast<double>(config.max_points_per_voxel));
+}
+
 VoxelMap::VoxelMap(const VoxelMapConfig& config, exec::CpuExecutor& executor)
     : config_(config),
       executor_(executor),
-      spacing_m_(static_cast<float>(config.voxel_size_m / std::sqrt(static_cast<double>(config.max_points_per_voxel)))) {
+      spacing_m_(static_cast<float>(point_spacing_m(config))) {
   if (config.voxel_size_m <= 0 || config.max_points_per_voxel <= 0 || config.covariance_neighbors <= 0 ||
       config.covariance_neighbors > kMaxNeighbors) {
     throw std::invalid_argument("VoxelMap: voxel_size_m and max_points_per_voxel must be > 0 and "

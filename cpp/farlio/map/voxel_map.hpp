@@ -35,6 +35,10 @@ struct PointLimit {
   }
 };
 
+/// The minimum distance between points of a voxel: config.point_spacing_m, or
+/// voxel_size_m / sqrt(max_points_per_voxel) when that is 0.
+double point_spacing_m(const VoxelMapConfig& config);
+
 struct InsertStats {
   std::size_t candidates = 0;        ///< points offered
   std::size_t inserted = 0;          ///< points added
@@ -61,7 +65,8 @@ class VoxelMap {
 
   [[nodiscard]] MapView view() const;
   [[nodiscard]] const VoxelMapConfig& config() const { return config_; }
-  /// Minimum distance between two points of a voxel: voxel_size / sqrt(max_points_per_voxel).
+  /// Minimum distance between two points of a voxel (config.point_spacing_m or
+  /// voxel_size / sqrt(max_points_per_voxel)).
   [[nodiscard]] float spacing_m() const { return spacing_m_; }
   [[nodiscard]] std::size_t num_voxels() const { return live_voxels_; }
   [[nodiscard]] std::size_t num_points() const;

@@ -18,6 +18,8 @@ constexpr double kNsPerS = 1e9;
 
 VoxelMapConfig frame_map_config(const Config& c) {
   VoxelMapConfig f = c.map;
+  // the frame map keeps the submap's spacing (the scan is downsampled to it) with a lower cap
+  f.point_spacing_m = map::point_spacing_m(c.map);
   f.max_points_per_voxel = c.density.frame_map_max_points_per_voxel;
   f.refresh_covariances = false;
   f.removal_radius_m = std::numeric_limits<double>::infinity();
