@@ -7,6 +7,7 @@
 
 #include "bindings.hpp"
 #include "farlio/core/config_fields.hpp"
+#include "farlio/pipeline/pairwise.hpp"
 #include "farlio/pipeline/scan_pipeline.hpp"
 
 namespace nb = nanobind;
@@ -62,6 +63,25 @@ void bind_pipeline(nb::module_& m) {
       .def_ro("map_voxels", &pipeline::FrameResult::map_voxels)
       .def_ro("map_points", &pipeline::FrameResult::map_points)
       .def_ro("timings", &pipeline::FrameResult::timings);
+
+  nb::class_<registration::RegistrationResult>(m, "RegistrationResult", "Pose with the Gauss-Newton system.")
+      .def_ro("pose", &registration::RegistrationResult::pose)
+      .def_ro("iterations", &registration::RegistrationResult::iterations)
+      .def_ro("converged", &registration::RegistrationResult::converged)
+      .def_ro("budget_exceeded", &registration::RegistrationResult::budget_exceeded)
+      .def_ro("time_s", &registration::RegistrationResult::time_s)
+      .def_prop_ro("hessian", [](const registration::RegistrationResult& r) { return r.system.H; })
+      .def_prop_ro("gradient", [](const registration::RegistrationResult& r) { return r.system.b; })
+      .def_prop_ro("error", [](const registration::RegistrationResult& r) { return r.system.error; })
+      .def_prop_ro("inliers", [](const registration::RegistrationResult& r) { return r.system.inliers; });
+
+  m.def(
+      "register_pair",
+      [](const Scan& source, const Scan& target, const SE3& guess, const Config& config) {
+        return pipeline::register_pair(source.points, target.points, guess, config);
+      },
+      "source"_a, "target"_a, "initial_guess"_a = SE3(), "config"_a = Config(), nb::call_guard<nb::gil_scoped_release>(),
+      "T_target_source by sparsity-aware GICP (the target becomes a voxel map).");
 
   nb::class_<pipeline::ScanPipeline>(m, "ScanPipeline",
                                      "preprocess -> sparsity-aware GICP against the adaptive submap -> map update")
