@@ -1,0 +1,59 @@
+#include "farlio/eval/ape.hpp"
+
+#include <string>
+
+#include "farlio/core/error.hpp"
+#include "farlio/eval/angles.hpp"
+
+namespace farlio::eval {
+namespace {
+
+struct PerPairErrors {
+  std::vector<double> translation_m;
+  std::vector<double> rotation_deg;
+};
+
+PerPairErrors pair_errors(std::span<const SE3> estimate, std::span<const SE3> groundtruth) {
+  PerPairErrors e;
+  e.translation_m.reserve(estimate.size());
+  e.rotation_deg.reserve(estimate.size());
+  for (std::size_t k = 0; k < estimate.size(); ++k) {
+    e.translation_m.push_back((groundtruth[k].translation() - estimate[k].translation()).norm());
+    e.rotation_deg.push_back((groundtruth[k].inverse() * estimate[k]).angle_rad() * kDegreesPerRadian);
+  }
+  return e;
+}
+
+}  // namespace
+
+ApeResult compute_ape(std::span<const SE3> estimate, std::span<const SE3> groundtruth, bool align_with_scale) {
+  if (estimate.size() != groundtruth.size()) {
+    throw InputError("compute_ape: " + std::to_string(estimate.size()) + " estimate poses but " +
+                     std::to_string(groundtruth.size()) + " ground-truth poses");
+  }
+  ApeResult r;
+  if (estimate.empty()) return r;
+
+  std::vector<Eigen::Vector3d> est_positions, gt_positions;
+  est_positions.reserve(estimate.size());
+  gt_positions.reserve(estimate.size());
+  for (std::size_t k = 0; k < estimate.size(); ++k) {
+    est_positions.push_back(estimate[k].translation());
+    gt_positions.push_back(groundtruth[k].translation());
+  }
+  r.alignment = umeyama_align(est_positions, gt_positions, align_with_scale);
+  r.aligned_estimate.reserve(estimate.size());
+  for (const SE3& pose : estimate) r.aligned_estimate.push_back(r.alignment.apply(pose));
+
+  const PerPairErrors raw = pair_errors(estimate, groundtruth);
+  r.translation_raw_m = compute_stats(raw.translation_m);
+  r.rotation_raw_deg = compute_stats(raw.rotation_deg);
+  PerPairErrors aligned = pair_errors(r.aligned_estimate, groundtruth);
+  r.translation_m = compute_stats(aligned.translation_m);
+  r.rotation_deg = compute_stats(aligned.rotation_deg);
+  r.translation_errors_m = std::move(aligned.translation_m);
+  r.rotation_errors_deg = std::move(aligned.rotation_deg);
+  return r;
+}
+
+}  // namespace farlio::eval

@@ -1,0 +1,62 @@
+#pragma once
+// The CPU executor: runs a kernel body for every index, in parallel on this executor's own TBB
+// arena. The thread count belongs to the instance (no process-wide setting), so two pipelines
+// in one process do not interfere.
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+#include <tbb/task_arena.h>
+
+#include <cstddef>
+
+namespace farlio::exec {
+
+class CpuExecutor {
+ public:
+  /// num_threads <= 0: all hardware threads.
+  explicit CpuExecutor(int num_threads = 0)
+      : arena_(num_threads > 0 ? num_threads : tbb::task_arena::automatic) {}
+
+  [[nodiscard]] int num_threads() const { return arena_.max_concurrency(); }
+
+  /// Calls body(i) for every i in [0, n).
+  template <typename Body>
+  void for_each(std::size_t n, const Body& body) {
+    if (n == 0) return;
+    arena_.execute([&] {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kGrain), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i < r.end(); ++i) body(i);
+      });
+    });
+  }
+
+  /// Sum over i in [0, n) of map(i), combined with `combine` (associative), starting from
+  /// `identity`. Deterministic for a given thread count and n (static partitioning).
+  template <typename T, typename Map, typename Combine>
+  T reduce(std::size_t n, const T& identity, const Map& map, const Combine& combine) {
+    if (n == 0) return identity;
+    T result = identity;
+    arena_.execute([&] {
+      result = tbb::parallel_deterministic_reduce(
+          tbb::blocked_range<std::size_t>(0, n, kGrain), identity,
+          [&](const tbb::blocked_range<std::size_t>& r, T acc) {
+            for (std::size_t i = r.begin(); i < r.end(); ++i) acc = combine(acc, map(i));
+            return acc;
+          },
+          combine);
+    });
+    return result;
+  }
+
+  /// Runs f() inside this executor's arena (for code that uses TBB algorithms directly).
+  template <typename F>
+  auto run(F&& f) {
+    return arena_.execute(std::forward<F>(f));
+  }
+
+ private:
+  static constexpr std::size_t kGrain = 256;  // indices per task: small enough to balance
+  tbb::task_arena arena_;
+};
+
+}  // namespace farlio::exec

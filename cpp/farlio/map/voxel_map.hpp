@@ -1,0 +1,104 @@
+#pragma once
+// VoxelMap: the host owner of a voxel hash map (cuVoxelMap's layout, see map_view.hpp) and its
+// updates on the CPU executor: insertion with a per-voxel cap and a minimum spacing,
+// covariances from the k nearest neighbours (eq. 1), removal of far voxels, and a growth
+// policy with a hard limit (CapacityError beyond map.max_voxel_capacity).
+//
+// Updates are deterministic: points are grouped by voxel (sorted by key, then by input order)
+// and each voxel's candidates are processed in that order by one task, so the map's contents do
+// not depend on the thread count.
+#include <Eigen/Core>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "farlio/core/config.hpp"
+#include "farlio/exec/cpu_executor.hpp"
+#include "farlio/map/map_view.hpp"
+
+namespace farlio::map {
+
+/// The per-voxel point limit for a point at a given distance from the sensor (ASMD, or a
+/// constant). Evaluated per inserted point.
+struct PointLimit {
+  int close_limit = 40;          ///< limit within close_range_m
+  float close_range_m = 0.0f;    ///< beyond it the limit decays linearly
+  float slope_per_m = 0.0f;      ///< points per metre of decay
+  int min_limit = 40;            ///< floor of the decay (k, so covariances stay computable)
+
+  static PointLimit constant(int n) { return {n, 0.0f, 0.0f, n}; }
+  FARLIO_HD int at(float distance_m) const {
+    if (distance_m <= close_range_m) return close_limit;
+    const float decayed = static_cast<float>(close_limit) - slope_per_m * (distance_m - close_range_m);
+    const int lim = static_cast<int>(decayed);
+    return lim > min_limit ? lim : min_limit;
+  }
+};
+
+struct InsertStats {
+  std::size_t candidates = 0;        ///< points offered
+  std::size_t inserted = 0;          ///< points added
+  std::size_t rejected_spacing = 0;  ///< closer than the spacing to a stored point
+  std::size_t rejected_full = 0;     ///< their voxel had reached its limit
+  std::size_t out_of_range = 0;      ///< outside the representable key range or non-finite
+  std::size_t new_voxels = 0;
+  std::size_t covariances_computed = 0;
+};
+
+class VoxelMap {
+ public:
+  VoxelMap(const VoxelMapConfig& config, exec::CpuExecutor& executor);
+
+  /// Inserts world-frame points; the limit of each point depends on its distance to `origin`
+  /// (the sensor position). Then computes covariances of the new points (and of all points of
+  /// the voxels that changed, when config.refresh_covariances).
+  InsertStats insert(const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& origin,
+                     const PointLimit& limit);
+  /// Removes voxels whose centre is farther than config.removal_radius_m from `origin`.
+  std::size_t remove_far(const Eigen::Vector3f& origin);
+  /// Removes everything (keeps the allocation).
+  void clear();
+
+  [[nodiscard]] MapView view() const;
+  [[nodiscard]] const VoxelMapConfig& config() const { return config_; }
+  /// Minimum distance between two points of a voxel: voxel_size / sqrt(max_points_per_voxel).
+  [[nodiscard]] float spacing_m() const { return spacing_m_; }
+  [[nodiscard]] std::size_t num_voxels() const { return live_voxels_; }
+  [[nodiscard]] std::size_t num_points() const;
+  [[nodiscard]] std::size_t voxel_capacity() const { return voxel_keys_.size(); }
+  [[nodiscard]] std::size_t table_capacity() const { return slot_keys_.size(); }
+  [[nodiscard]] std::size_t memory_bytes() const;
+
+  /// Calls f(point, covariance, covariance_valid) for every stored point (host only).
+  void for_each_point(const std::function<void(const Eigen::Vector3f&, const Cov3&, bool)>& f) const;
+  /// Mean number of points per voxel over voxels whose centre lies within `range_m` of
+  /// `origin`; 0 when none does (used by the adaptive submap density).
+  [[nodiscard]] double mean_points_per_voxel(const Eigen::Vector3f& origin, double range_m) const;
+
+  /// Table size used before the first growth (a small table forces probing in tests).
+  void set_table_capacity_for_testing(std::size_t slots);
+
+ private:
+  void reserve_voxels(std::size_t needed);
+  void rehash(std::size_t slots);
+  std::int32_t allocate_voxel(std::uint64_t key);
+  void compute_covariances(const std::vector<std::int32_t>& voxels, const std::vector<std::int32_t>& first_point);
+
+  VoxelMapConfig config_;
+  exec::CpuExecutor& executor_;
+  float spacing_m_;
+  // hash table
+  std::vector<std::uint64_t> slot_keys_;
+  std::vector<std::int32_t> slot_voxels_;
+  std::size_t used_slots_ = 0;    // live + erased
+  // voxel pool
+  std::vector<std::uint64_t> voxel_keys_;  // kEmptyKey when free
+  std::vector<std::int32_t> voxel_counts_;
+  std::vector<Eigen::Vector4f> points_;
+  std::vector<Cov3> covs_;
+  std::vector<std::int32_t> free_voxels_;
+  std::size_t high_water_ = 0;   // voxels [0, high_water_) have been used at least once
+  std::size_t live_voxels_ = 0;
+};
+
+}  // namespace farlio::map

@@ -1,0 +1,20 @@
+#pragma once
+// Preprocessing of a scan: range crop and voxel-grid downsampling to the map spacing.
+#include <Eigen/Core>
+#include <vector>
+
+#include "farlio/core/config.hpp"
+#include "farlio/exec/cpu_executor.hpp"
+
+namespace farlio::pipeline {
+
+/// Indices of the points whose range lies in [min_range_m, max_range_m] and that are finite.
+std::vector<std::int32_t> crop_by_range(const std::vector<Eigen::Vector3f>& points, const PreprocessConfig& config);
+
+/// Keeps one point per cell of size `cell_m`: the first in the order of `indices` (no
+/// centroid, so kept points are measured points). Returns the kept indices, sorted by cell.
+std::vector<std::int32_t> voxel_downsample(const std::vector<Eigen::Vector3f>& points,
+                                           const std::vector<std::int32_t>& indices, float cell_m,
+                                           exec::CpuExecutor& executor);
+
+}  // namespace farlio::pipeline

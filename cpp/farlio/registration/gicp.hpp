@@ -1,0 +1,50 @@
+#pragma once
+// Sparsity-aware GICP, scan to submap (paper section III-A): Gauss-Newton on SE(3) over the
+// per-point factors of gicp_factor.hpp, correspondences limited to 3 sigma and the Cauchy
+// kernel scale kappa = sigma / 3 (KISS-ICP's adaptive threshold), stopped when |dx| falls below
+// the convergence norm or the time budget runs out. Returns the pose with the linear system.
+#include <vector>
+
+#include "farlio/core/config.hpp"
+#include "farlio/core/se3.hpp"
+#include "farlio/exec/cpu_executor.hpp"
+#include "farlio/map/map_view.hpp"
+#include "farlio/registration/linear_system.hpp"
+
+namespace farlio::registration {
+
+/// Registration input: points in the sensor frame, w = 1 where the covariance is valid.
+struct SourceCloud {
+  std::vector<Eigen::Vector4f> points;
+  std::vector<map::Cov3> covs;
+  [[nodiscard]] std::size_t size() const { return points.size(); }
+};
+
+struct RegistrationResult {
+  SE3 pose;                      ///< registered sensor pose in the map frame
+  LinearSystem system;           ///< the system of the last iteration (at the pose before its step)
+  int iterations = 0;
+  bool converged = false;        ///< |dx| fell below the convergence norm
+  bool budget_exceeded = false;  ///< stopped by the time budget
+  double time_s = 0.0;
+};
+
+/// The stored points of a map with their covariances (the per-scan frame map gives the source).
+SourceCloud source_from_map(const map::MapView& frame_map, std::size_t voxel_capacity);
+
+/// Correspondence distance (3 sigma) and kernel scale (sigma / 3), as in KISS-ICP.
+struct Thresholds {
+  double max_correspondence_m;
+  double kernel_scale_m;
+  static Thresholds from_sigma(double sigma_m) { return {3.0 * sigma_m, sigma_m / 3.0}; }
+};
+
+/// The linear system of `source` at pose T against the map.
+LinearSystem build_linear_system(const SourceCloud& source, const map::MapView& target, const SE3& T,
+                                 const Thresholds& th, bool sparsity_aware, exec::CpuExecutor& executor);
+
+RegistrationResult register_scan(const SourceCloud& source, const map::MapView& target, const SE3& initial_guess,
+                                 const Thresholds& th, const RegistrationConfig& config, double time_budget_s,
+                                 exec::CpuExecutor& executor);
+
+}  // namespace farlio::registration

@@ -1,0 +1,72 @@
+#pragma once
+// The per-point factor of the sparsity-aware GICP (paper eqs. 3-5), a kernel body shared by the
+// CPU executor and CUDA. For a source point s with covariance C_s (sensor frame) and the
+// current pose T = (R, t): p = R s + t is matched to its nearest map point q within the
+// correspondence distance; the residual r = p - q is weighted by
+//   Omega = (C_q + R C_s R^T)^-1   when both covariances exist (GICP),
+//   Omega = I                      otherwise (Sigma_r = I, Sigma_s = 0: point-to-point),
+// and by the Cauchy weight of |r|. The Jacobian of r under a right perturbation
+// T exp(delta), delta = [rho; phi], is J = [R, -R [s]x].
+#include <Eigen/Core>
+#include <Eigen/LU>
+
+#include "farlio/exec/hd.hpp"
+#include "farlio/map/map_view.hpp"
+#include "farlio/map/neighbor_search.hpp"
+#include "farlio/registration/robust_kernel.hpp"
+
+namespace farlio::registration {
+
+/// One factor's contribution in float: the upper triangle of H (21), b (6), cost, inlier flag.
+struct FactorTerms {
+  float H[21];
+  float b[6];
+  float cost;
+  int inlier;
+};
+
+struct FactorParams {
+  Eigen::Matrix3f R;
+  Eigen::Vector3f t;
+  float max_correspondence_distance2;
+  CauchyKernel kernel;
+  bool sparsity_aware;
+};
+
+/// Computes the factor of source point `s` (w = 1 if `cov_s` is valid). Returns false (and
+/// leaves `out` untouched) when there is no correspondence within the distance.
+FARLIO_HD inline bool gicp_factor(const map::MapView& m, const Eigen::Vector4f& s, const map::Cov3& cov_s,
+                                  const FactorParams& fp, FactorTerms& out) {
+  const Eigen::Vector3f sp = s.head<3>();
+  const Eigen::Vector3f p = fp.R * sp + fp.t;
+  const std::int64_t nn = map::nearest_neighbor(m, p, fp.max_correspondence_distance2);
+  if (nn < 0) return false;
+  const Eigen::Vector4f& q = m.points[nn];
+  const Eigen::Vector3f r = p - q.head<3>();
+  Eigen::Matrix3f omega = Eigen::Matrix3f::Identity();
+  if (fp.sparsity_aware && s.w() > 0.0f && q.w() > 0.0f) {
+    const Eigen::Matrix3f c = m.covs[nn].matrix() + fp.R * cov_s.matrix() * fp.R.transpose();
+    const Eigen::Matrix3f inv = c.inverse();
+    if (inv.allFinite()) omega = inv;
+  }
+  const float r2 = r.squaredNorm();
+  const float w = fp.kernel.weight(r2);
+  Eigen::Matrix<float, 3, 6> J;
+  J.leftCols<3>() = fp.R;
+  Eigen::Matrix3f sx;
+  sx << 0.0f, -sp.z(), sp.y(), sp.z(), 0.0f, -sp.x(), -sp.y(), sp.x(), 0.0f;
+  J.rightCols<3>() = -fp.R * sx;
+  const Eigen::Matrix<float, 6, 3> JtW = w * (J.transpose() * omega);
+  const Eigen::Matrix<float, 6, 6> H = JtW * J;
+  const Eigen::Matrix<float, 6, 1> b = JtW * r;
+  int k = 0;
+  for (int i = 0; i < 6; ++i) {
+    for (int j = i; j < 6; ++j) out.H[k++] = H(i, j);
+    out.b[i] = b(i);
+  }
+  out.cost = fp.kernel.cost(r2);
+  out.inlier = 1;
+  return true;
+}
+
+}  // namespace farlio::registration

@@ -1,0 +1,48 @@
+"""The `farlio` command line tool: one entry point, one subcommand per job.
+
+Every subcommand that writes files takes ``--out DIR``; ``farlio <command> --help`` documents
+every option.
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+# name -> (module, help). Each module provides add_arguments(parser) and run(args) -> int.
+COMMANDS = {
+    "run": ("farlio.commands.run", "run the odometry over a recording and write trajectories, timings, summary"),
+    "simulate": ("farlio.commands.simulate", "generate a LiDAR + IMU sequence with exact ground truth"),
+    "eval": ("farlio.commands.evaluate", "compare a trajectory with ground truth (APE, RPE, coverage)"),
+    "info": ("farlio.commands.info", "print the build (CUDA backend, devices) and version"),
+}
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="farlio",
+        description="farlio: fast, accurate, robust LiDAR-inertial odometry.",
+    )
+    sub = parser.add_subparsers(dest="command", metavar="<command>", required=True)
+    for name, (module, help_text) in COMMANDS.items():
+        p = sub.add_parser(name, help=help_text, description=help_text,
+                           formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+        importlib.import_module(module).add_arguments(p)
+        p.set_defaults(_module=module)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return int(importlib.import_module(args._module).run(args) or 0)
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr)
+        return 130
+    except (ValueError, OSError, RuntimeError) as e:  # InputError is a ValueError
+        print(f"farlio {args.command}: error: {e}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,60 @@
+"""The parameter set from Python: defaults, YAML files and `key=value` overrides.
+
+Field names are the dotted names of the C++ Config (e.g. ``map.voxel_size_m``); a YAML file may
+nest them (``map: {voxel_size_m: 2.0}``). Unknown names are errors that name the field.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Iterable
+
+import yaml
+
+from ._core import Config
+
+
+def _flatten(d: dict, prefix: str = "") -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for k, v in d.items():
+        name = f"{prefix}{k}"
+        if isinstance(v, dict):
+            out.update(_flatten(v, name + "."))
+        else:
+            out[name] = v
+    return out
+
+
+def _text(v: Any) -> str:
+    return ("true" if v else "false") if isinstance(v, bool) else str(v)
+
+
+def load_config(yaml_path: Path | None = None, overrides: Iterable[str] = ()) -> Config:
+    """Defaults, then the YAML file, then `key=value` overrides (later wins)."""
+    cfg = Config()
+    if yaml_path is not None:
+        data = yaml.safe_load(Path(yaml_path).read_text()) or {}
+        if not isinstance(data, dict):
+            raise ValueError(f"{yaml_path}: expected a mapping of config fields")
+        for name, value in _flatten(data).items():
+            try:
+                cfg.set(name, _text(value))
+            except ValueError as e:
+                raise ValueError(f"{yaml_path}: {e}") from None
+    for item in overrides:
+        if "=" not in item:
+            raise ValueError(f"--set expects key=value, got '{item}'")
+        name, value = item.split("=", 1)
+        cfg.set(name.strip(), value.strip())
+    return cfg
+
+
+def config_to_yaml(cfg: Config) -> str:
+    """The full effective config as nested YAML (every field, defaults included)."""
+    nested: dict[str, Any] = {}
+    for name, text in cfg.to_dict().items():
+        node = nested
+        *parents, leaf = name.split(".")
+        for p in parents:
+            node = node.setdefault(p, {})
+        node[leaf] = yaml.safe_load(text)
+    return yaml.safe_dump(nested, sort_keys=False)

@@ -1,0 +1,47 @@
+"""The dataset interface every dataloader implements."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import farlio
+
+
+class Dataset:
+    """A recording: scans in time order, optional IMU, extrinsic and ground truth."""
+
+    #: path the dataset was opened from
+    path: Path
+
+    @classmethod
+    def matches(cls, path: Path) -> bool:  # pragma: no cover - interface
+        raise NotImplementedError
+
+    def __len__(self) -> int:  # pragma: no cover - interface
+        raise NotImplementedError
+
+    def scan(self, i: int) -> farlio.Scan:  # pragma: no cover - interface
+        """Scan i with start/end stamps (ns) and, where recorded, per-point times."""
+        raise NotImplementedError
+
+    def scan_source(self, i: int) -> str:
+        """Where scan i comes from (a file, a bag message), for error messages."""
+        return f"{self.path} scan {i}"
+
+    def imu(self) -> list[farlio.ImuSample]:
+        """All IMU samples in time order (empty: LiDAR-only)."""
+        return []
+
+    def T_imu_lidar(self) -> farlio.SE3:
+        """Maps LiDAR points into the IMU (body) frame; identity when unknown."""
+        return farlio.SE3()
+
+    def groundtruth_scans(self) -> farlio.Trajectory | None:
+        """True body poses at the scan end stamps, when the recording has them."""
+        return None
+
+    def warnings(self) -> list[str]:
+        return []
+
+    @property
+    def name(self) -> str:
+        return Path(self.path).name

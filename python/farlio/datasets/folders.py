@@ -1,0 +1,119 @@
+"""Dataloaders for folders: the sequence folder format, KITTI odometry, plain point cloud folders."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import farlio
+from farlio import _core
+
+from .base import Dataset
+
+POINT_CLOUD_SUFFIXES = (".pcd", ".pcd.gz", ".ply", ".bin")
+#: Scan period assumed for folders without stamps (10 Hz, the common spinning-LiDAR rate).
+DEFAULT_PERIOD_NS = 100_000_000
+
+
+def _is_cloud(p: Path) -> bool:
+    return p.is_file() and any(p.name.endswith(s) for s in POINT_CLOUD_SUFFIXES)
+
+
+def _with_stamps(scan: farlio.Scan, start_ns: int, end_ns: int) -> farlio.Scan:
+    scan.start_stamp_ns = start_ns
+    scan.end_stamp_ns = end_ns
+    return scan
+
+
+class SequenceFolder(Dataset):
+    """The neutral sequence folder (docs/sequence-folder.md): lidar/, imu.csv, calib.yaml, ground truth."""
+
+    @classmethod
+    def matches(cls, path: Path) -> bool:
+        return (path / "lidar").is_dir()
+
+    def __init__(self, path: Path):
+        self.path = Path(path)
+        self._reader = _core.io.SequenceReader(self.path)
+
+    def __len__(self) -> int:
+        return self._reader.num_scans()
+
+    def scan(self, i: int) -> farlio.Scan:
+        return self._reader.read_scan(i)
+
+    def scan_source(self, i: int) -> str:
+        return str(self._reader.scan_path(i))
+
+    def imu(self) -> list[farlio.ImuSample]:
+        return self._reader.imu() if self._reader.has_imu() else []
+
+    def T_imu_lidar(self) -> farlio.SE3:
+        return self._reader.calibration().T_imu_lidar
+
+    def groundtruth_scans(self) -> farlio.Trajectory | None:
+        return self._reader.groundtruth_scans()
+
+    def warnings(self) -> list[str]:
+        return list(self._reader.warnings())
+
+
+class KittiOdometry(Dataset):
+    """A KITTI odometry sequence: velodyne/NNNNNN.bin and times.txt (seconds); no per-point time
+    (KITTI scans are already undistorted). Ground truth is read from groundtruth_kitti.txt or
+    ../../poses/<seq>.txt when present (LiDAR poses, first = identity)."""
+
+    @classmethod
+    def matches(cls, path: Path) -> bool:
+        return (path / "velodyne").is_dir()
+
+    def __init__(self, path: Path):
+        self.path = Path(path)
+        self._files = sorted(p for p in (self.path / "velodyne").iterdir() if p.suffix == ".bin")
+        if not self._files:
+            raise ValueError(f"{self.path / 'velodyne'}: no .bin scans")
+        times = self.path / "times.txt"
+        if times.exists():
+            stamps = [round(float(line) * 1e9) for line in times.read_text().split()]
+            if len(stamps) != len(self._files):
+                raise ValueError(f"{times}: {len(stamps)} stamps for {len(self._files)} scans in velodyne/")
+            # KITTI stamps can start at 0: shift so that the first scan has a positive start
+            self._stamps = [s + DEFAULT_PERIOD_NS for s in stamps]
+        else:
+            self._stamps = [(i + 1) * DEFAULT_PERIOD_NS for i in range(len(self._files))]
+
+    def __len__(self) -> int:
+        return len(self._files)
+
+    def scan(self, i: int) -> farlio.Scan:
+        period = self._stamps[i] - self._stamps[i - 1] if i > 0 else DEFAULT_PERIOD_NS
+        return _with_stamps(_core.io.read_point_cloud(self._files[i]), self._stamps[i] - period, self._stamps[i])
+
+    def scan_source(self, i: int) -> str:
+        return str(self._files[i])
+
+
+class PointCloudFolder(Dataset):
+    """A folder of .pcd/.pcd.gz/.ply/.bin files, one scan each, in name order. Stamps: the file
+    name when it is an integer (ns), else DEFAULT_PERIOD_NS apart."""
+
+    @classmethod
+    def matches(cls, path: Path) -> bool:
+        return path.is_dir() and any(_is_cloud(p) for p in path.iterdir())
+
+    def __init__(self, path: Path):
+        self.path = Path(path)
+        self._files = sorted(p for p in self.path.iterdir() if _is_cloud(p))
+        stems = [p.name.split(".")[0] for p in self._files]
+        if all(s.isdigit() and len(s) > 12 for s in stems):
+            self._stamps = [int(s) for s in stems]
+        else:
+            self._stamps = [(i + 1) * DEFAULT_PERIOD_NS for i in range(len(self._files))]
+
+    def __len__(self) -> int:
+        return len(self._files)
+
+    def scan(self, i: int) -> farlio.Scan:
+        period = self._stamps[i] - self._stamps[i - 1] if i > 0 else DEFAULT_PERIOD_NS
+        return _with_stamps(_core.io.read_point_cloud(self._files[i]), self._stamps[i] - period, self._stamps[i])
+
+    def scan_source(self, i: int) -> str:
+        return str(self._files[i])

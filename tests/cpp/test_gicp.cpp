@@ -1,0 +1,151 @@
+// Sparsity-aware GICP: known transforms from perturbed starts, the point-to-point fallback,
+// the time budget, and the adaptive threshold.
+#include <gtest/gtest.h>
+
+#include "farlio/map/voxel_map.hpp"
+#include "farlio/registration/adaptive_threshold.hpp"
+#include "farlio/registration/gicp.hpp"
+#include "farlio/registration/gicp_factor.hpp"
+#include "scene_fixture.hpp"
+
+using namespace farlio;
+using namespace farlio::registration;
+
+namespace {
+
+struct Problem {
+  exec::CpuExecutor ex{2};
+  map::VoxelMap target{VoxelMapConfig{}, ex};
+  map::VoxelMap frame;
+  SourceCloud source;
+  SE3 truth;
+
+  static VoxelMapConfig frame_config() {
+    VoxelMapConfig c;
+    c.max_points_per_voxel = 20;
+    return c;
+  }
+  Problem(const SE3& t, bool sparse_source = false) : frame(frame_config(), ex), truth(t) {
+    target.insert(test::sample_scene(120000, 1), Eigen::Vector3f::Zero(), map::PointLimit::constant(40));
+    auto src_world = test::sample_scene(60000, 2, 0.01f);
+    if (sparse_source) {  // dense on the left half, a few isolated floor points on the right
+      std::erase_if(src_world, [](const Eigen::Vector3f& p) { return p.x() > 0.0f; });
+      for (int i = 0; i < 40; ++i) {
+        src_world.emplace_back(10.0f + 0.35f * static_cast<float>(i % 5 * 8), -24.0f + 1.2f * static_cast<float>(i), 0.0f);
+      }
+    }
+    std::vector<Eigen::Vector3f> src_sensor;
+    const SE3 inv = t.inverse();
+    for (const auto& p : src_world) src_sensor.push_back((inv * p.cast<double>()).cast<float>());
+    frame.insert(src_sensor, Eigen::Vector3f::Zero(), map::PointLimit::constant(20));
+    source = source_from_map(frame.view(), frame.voxel_capacity());
+  }
+};
+
+SE3 make_pose(double x, double y, double z, double yaw_deg, double roll_deg = 0) {
+  Vec6d xi;
+  xi << x, y, z, roll_deg * M_PI / 180.0, 0, yaw_deg * M_PI / 180.0;
+  return SE3(SE3::exp(xi).quaternion(), Eigen::Vector3d(x, y, z));
+}
+
+double trans_err(const SE3& a, const SE3& b) { return (a.inverse() * b).translation().norm(); }
+double rot_err_deg(const SE3& a, const SE3& b) { return (a.inverse() * b).angle_rad() * 180.0 / M_PI; }
+
+}  // namespace
+
+class GicpRecovers : public ::testing::TestWithParam<std::tuple<double, double>> {};
+
+TEST_P(GicpRecovers, KnownTransformFromPerturbedStart) {
+  const auto [offset_m, angle_deg] = GetParam();
+  Problem pb(make_pose(1.5, -0.7, 0.4, 20.0, 2.0));
+  Vec6d d;
+  d << offset_m / std::sqrt(3.0), -offset_m / std::sqrt(3.0), offset_m / std::sqrt(3.0), 0.3 * angle_deg * M_PI / 180.0,
+      -0.3 * angle_deg * M_PI / 180.0, 0.9 * angle_deg * M_PI / 180.0;
+  const SE3 guess = pb.truth * SE3::exp(d);
+  ASSERT_GT(pb.source.size(), 1000u);
+  RegistrationConfig cfg;
+  const auto res = register_scan(pb.source, pb.target.view(), guess, Thresholds::from_sigma(1.0), cfg, 10.0, pb.ex);
+  EXPECT_TRUE(res.converged);
+  EXPECT_LT(trans_err(res.pose, pb.truth), 0.02) << "iterations " << res.iterations;
+  EXPECT_LT(rot_err_deg(res.pose, pb.truth), 0.1);
+  EXPECT_GT(res.system.inliers, static_cast<long>(pb.source.size() * 8 / 10));
+  // the returned H is the Gauss-Newton information: symmetric positive definite here
+  EXPECT_LT((res.system.H - res.system.H.transpose()).norm(), 1e-9 * res.system.H.norm());
+  EXPECT_GT(res.system.H.ldlt().vectorD().minCoeff(), 0.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Perturbations, GicpRecovers,
+                         ::testing::Values(std::make_tuple(0.0, 0.0), std::make_tuple(0.5, 0.0),
+                                           std::make_tuple(0.0, 5.0), std::make_tuple(0.5, 5.0)));
+
+TEST(Gicp, PointToPointFallbackWithoutCovariance) {
+  // A source point without a covariance is weighted by Omega = I (Sigma_r = I, Sigma_s = 0).
+  exec::CpuExecutor ex(1);
+  map::VoxelMap target(VoxelMapConfig{}, ex);
+  target.insert(test::sample_scene(60000, 3), Eigen::Vector3f::Zero(), map::PointLimit::constant(40));
+  FactorParams fp{Eigen::Matrix3f::Identity(), Eigen::Vector3f(0.05f, 0.0f, 0.0f), 4.0f, CauchyKernel{1e6f}, true};
+  const Eigen::Vector4f with_cov(3.0f, 2.0f, 0.0f, 1.0f), without(3.0f, 2.0f, 0.0f, 0.0f);
+  map::Cov3 c = map::Cov3::from(Eigen::Matrix3f::Identity() * 0.01f);
+  FactorTerms f_cov{}, f_p2p{};
+  ASSERT_TRUE(gicp_factor(target.view(), with_cov, c, fp, f_cov));
+  ASSERT_TRUE(gicp_factor(target.view(), without, c, fp, f_p2p));
+  // point-to-point: the translation block of H is w * I (kernel weight ~1 with a huge kappa)
+  EXPECT_NEAR(f_p2p.H[0], 1.0f, 1e-4f);   // H(0,0)
+  EXPECT_NEAR(f_p2p.H[1], 0.0f, 1e-6f);   // H(0,1)
+  EXPECT_NEAR(f_p2p.H[6], 1.0f, 1e-4f);   // H(1,1)
+  // GICP on the floor: the normal direction (z) dominates the information
+  EXPECT_GT(f_cov.H[15], 10.0f * f_cov.H[0]);  // H(2,2) >> H(0,0)
+  // and with the sparsity-aware switch off, the valid covariance is ignored too
+  fp.sparsity_aware = false;
+  FactorTerms f_off{};
+  ASSERT_TRUE(gicp_factor(target.view(), with_cov, c, fp, f_off));
+  for (int k = 0; k < 21; ++k) EXPECT_FLOAT_EQ(f_off.H[k], f_p2p.H[k]);
+}
+
+TEST(Gicp, SparseSourceStillRegisters) {
+  // Isolated floor points have fewer than k neighbours, so they get no covariance.
+  Problem pb(make_pose(0.5, 0.2, 0.0, 3.0), true);
+  std::size_t without = 0;
+  for (const auto& p : pb.source.points) without += p.w() > 0 ? 0 : 1;
+  EXPECT_GE(without, 20u) << "the fallback must be exercised";
+  const SE3 guess = pb.truth * make_pose(0.3, -0.2, 0.1, 2.0);
+  const auto res = register_scan(pb.source, pb.target.view(), guess, Thresholds::from_sigma(1.0), RegistrationConfig{},
+                                 10.0, pb.ex);
+  EXPECT_LT(trans_err(res.pose, pb.truth), 0.05);
+  EXPECT_LT(rot_err_deg(res.pose, pb.truth), 0.2);
+}
+
+TEST(Gicp, TimeBudgetStopsIt) {
+  Problem pb(make_pose(0, 0, 0, 0));
+  const SE3 guess = make_pose(0.5, 0.3, 0.0, 4.0);
+  const auto res = register_scan(pb.source, pb.target.view(), guess, Thresholds::from_sigma(1.0), RegistrationConfig{},
+                                 0.0, pb.ex);
+  EXPECT_EQ(res.iterations, 1);
+  EXPECT_TRUE(res.budget_exceeded);
+  EXPECT_FALSE(res.converged);
+}
+
+TEST(Gicp, NoCorrespondencesIsNotConvergence) {
+  Problem pb(make_pose(0, 0, 0, 0));
+  const SE3 far_away = make_pose(500.0, 0.0, 0.0, 0.0);
+  const auto res = register_scan(pb.source, pb.target.view(), far_away, Thresholds::from_sigma(1.0),
+                                 RegistrationConfig{}, 1.0, pb.ex);
+  EXPECT_FALSE(res.converged);
+  EXPECT_EQ(res.system.inliers, 0);
+  EXPECT_LT(trans_err(res.pose, far_away), 1e-12);  // pose untouched
+}
+
+TEST(AdaptiveThreshold, FollowsTheRmsOfSampledDeviations) {
+  ThresholdConfig cfg;
+  AdaptiveThreshold th(cfg);
+  EXPECT_DOUBLE_EQ(th.sigma_m(), cfg.initial_threshold_m);
+  th.update(make_pose(0.1, 0, 0, 0));  // below min motion: not sampled
+  EXPECT_DOUBLE_EQ(th.sigma_m(), 1.0);
+  th.update(make_pose(2.0, 0, 0, 0));
+  EXPECT_NEAR(th.sigma_m(), std::sqrt((1.0 + 4.0) / 2.0), 1e-12);
+  // a rotation counts as its displacement at max range: 2 * 100 * sin(0.5 deg / 2)
+  const double e = th.update(make_pose(0, 0, 0, 0.5));
+  EXPECT_NEAR(e, 200.0 * std::sin(0.25 * M_PI / 180.0), 1e-9);
+  th.update(make_pose(1000.0, 0, 0, 0));
+  EXPECT_DOUBLE_EQ(th.sigma_m(), cfg.max_threshold_m);
+}
