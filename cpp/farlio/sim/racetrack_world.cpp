@@ -23,7 +23,14 @@ constexpr double kBarrierOffset_m = 7.0, kBarrierHeight_m = 1.0, kBarrierThickne
 constexpr double kFenceOffset_m = 10.5, kFenceHeight_m = 3.5, kFenceThickness_m = 0.05, kFenceStep_m = 8.0;
 constexpr double kFenceGapChance = 0.12;
 constexpr double kPostOffset_m = 8.8, kPostSpacingMin_m = 20.0, kPostSpacingMax_m = 60.0;
+constexpr double kPostRadiusMin_m = 0.12, kPostRadiusMax_m = 0.3, kPostHeightMin_m = 4.0, kPostHeightMax_m = 8.0;
 constexpr double kBoardSpacingMin_m = 60.0, kBoardSpacingMax_m = 180.0;
+constexpr double kBoardHeightMin_m = 1.5, kBoardHeightMax_m = 3.0, kBoardHalfWidthMin_m = 0.5, kBoardHalfWidthMax_m = 1.5;
+constexpr double kBoardHalfDepth_m = 0.4, kBoardYawJitter_rad = 0.3;
+constexpr double kTrunkRadius_m = 0.25, kTrunkHeight_m = 3.0, kCrownRadiusMin_m = 1.5, kCrownRadiusMax_m = 3.0;
+constexpr double kCrownTopMin_m = 6.0, kCrownTopMax_m = 12.0;
+constexpr float kBarrierReflectivity = 0.5F, kFenceReflectivity = 0.25F, kPostReflectivity = 0.7F;
+constexpr float kBoardReflectivity = 0.9F, kTrunkReflectivity = 0.4F, kCrownReflectivity = 0.35F;
 constexpr double kTreeOffsetMin_m = 14.0, kTreeOffsetMax_m = 40.0, kTreeSpacing_m = 25.0, kTreeChance = 0.5;
 constexpr double kSegmentOverlap_m = 0.05;
 // Sensors.
@@ -68,41 +75,54 @@ void add_trackside_objects(Scene& scene, const Path& path, Rng& rng) {
     for (double s = rng.uniform(0.0, kPostSpacingMax_m); s < path.length_m(); s += rng.uniform(kPostSpacingMin_m, kPostSpacingMax_m)) {
       const PathPoint p = path.at(s);
       const Eigen::Vector2d c = p.position_m + side * kPostOffset_m * p.normal;
-      scene.add(Cylinder{c, rng.uniform(0.12, 0.3), 0.0, rng.uniform(4.0, 8.0), 0.7F});
+      scene.add(Cylinder{c, rng.uniform(kPostRadiusMin_m, kPostRadiusMax_m), 0.0,
+                         rng.uniform(kPostHeightMin_m, kPostHeightMax_m), kPostReflectivity});
     }
     for (double s = rng.uniform(0.0, kBoardSpacingMax_m); s < path.length_m(); s += rng.uniform(kBoardSpacingMin_m, kBoardSpacingMax_m)) {
       const PathPoint p = path.at(s);
       const Eigen::Vector2d c = p.position_m + side * kPostOffset_m * p.normal;
-      const double h = rng.uniform(1.5, 3.0);
-      scene.add(Box{Eigen::Vector3d(c.x(), c.y(), 0.5 * h), Eigen::Vector3d(rng.uniform(0.5, 1.5), 0.4, 0.5 * h),
-                    p.heading_rad + rng.uniform(-0.3, 0.3), 0.9F});
+      const double h = rng.uniform(kBoardHeightMin_m, kBoardHeightMax_m);
+      scene.add(Box{Eigen::Vector3d(c.x(), c.y(), 0.5 * h), Eigen::Vector3d(rng.uniform(kBoardHalfWidthMin_m, kBoardHalfWidthMax_m), kBoardHalfDepth_m, 0.5 * h),
+                    p.heading_rad + rng.uniform(-kBoardYawJitter_rad, kBoardYawJitter_rad), kBoardReflectivity});
     }
     for (double s = 0.0; s < path.length_m(); s += kTreeSpacing_m) {
       if (!rng.chance(kTreeChance)) continue;
       const PathPoint p = path.at(s + rng.uniform(0.0, kTreeSpacing_m));
       const Eigen::Vector2d c = p.position_m + side * rng.uniform(kTreeOffsetMin_m, kTreeOffsetMax_m) * p.normal;
       if (!clear_of_track(path, c)) continue;  // another part of the circuit may pass nearby
-      scene.add(Cylinder{c, 0.25, 0.0, 3.0, 0.4F});
-      scene.add(Cylinder{c, rng.uniform(1.5, 3.0), 3.0, rng.uniform(6.0, 12.0), 0.35F});
+      scene.add(Cylinder{c, kTrunkRadius_m, 0.0, kTrunkHeight_m, kTrunkReflectivity});
+      scene.add(Cylinder{c, rng.uniform(kCrownRadiusMin_m, kCrownRadiusMax_m), kTrunkHeight_m,
+                         rng.uniform(kCrownTopMin_m, kCrownTopMax_m), kCrownReflectivity});
     }
   }
 }
 
 /// Stepped grandstands on the outside of the main straight (y < 0) and a pit building inside.
 void add_buildings(Scene& scene) {
-  constexpr double kStepDepth_m = 3.5, kStepRise_m = 2.5, kStandFront_m = 13.0;
+  constexpr double kStepDepth_m = 3.5, kStepRise_m = 2.5, kStandFront_m = 13.0, kStandBaseHeight_m = 4.0;
+  constexpr double kStandHalfLength_m = 100.0;
   constexpr int kSteps = 5;
+  constexpr float kStandReflectivity = 0.5F, kPitReflectivity = 0.6F, kGarageReflectivity = 0.8F;
   for (const double x_center : {-380.0, -120.0, 180.0}) {
     for (int k = 0; k < kSteps; ++k) {
-      const double h = 4.0 + kStepRise_m * k;
+      const double h = kStandBaseHeight_m + kStepRise_m * k;
       const double y = -(kStandFront_m + kStepDepth_m * (k + 0.5));
-      scene.add(Box{Eigen::Vector3d(x_center, y, 0.5 * h), Eigen::Vector3d(100.0, 0.5 * kStepDepth_m, 0.5 * h), 0.0, 0.5F});
+      scene.add(Box{Eigen::Vector3d(x_center, y, 0.5 * h), Eigen::Vector3d(kStandHalfLength_m, 0.5 * kStepDepth_m, 0.5 * h),
+                    0.0, kStandReflectivity});
     }
   }
+  // Pit building x in [-270, 170], y in [16, 32]; garage walls stick out of its front to y = 12.
+  constexpr double kPitCenterX_m = -50.0, kPitCenterY_m = 24.0, kPitHalfLength_m = 220.0, kPitHalfDepth_m = 8.0;
   constexpr double kPitHeight_m = 8.0;
-  scene.add(Box{Eigen::Vector3d(-50.0, 24.0, 0.5 * kPitHeight_m), Eigen::Vector3d(220.0, 8.0, 0.5 * kPitHeight_m), 0.0, 0.6F});
-  for (int k = 0; k < 12; ++k)  // pit garages' dividing walls sticking out of the building front
-    scene.add(Box{Eigen::Vector3d(-250.0 + 40.0 * k, 14.0, 1.5), Eigen::Vector3d(0.3, 2.0, 1.5), 0.0, 0.8F});
+  scene.add(Box{Eigen::Vector3d(kPitCenterX_m, kPitCenterY_m, 0.5 * kPitHeight_m),
+                Eigen::Vector3d(kPitHalfLength_m, kPitHalfDepth_m, 0.5 * kPitHeight_m), 0.0, kPitReflectivity});
+  constexpr int kGarages = 12;
+  constexpr double kGarageFirstX_m = -250.0, kGaragePitch_m = 40.0, kGarageWallY_m = 14.0;
+  constexpr double kGarageWallHalfThickness_m = 0.3, kGarageWallHalfDepth_m = 2.0, kGarageWallHeight_m = 3.0;
+  for (int k = 0; k < kGarages; ++k)
+    scene.add(Box{Eigen::Vector3d(kGarageFirstX_m + kGaragePitch_m * k, kGarageWallY_m, 0.5 * kGarageWallHeight_m),
+                  Eigen::Vector3d(kGarageWallHalfThickness_m, kGarageWallHalfDepth_m, 0.5 * kGarageWallHeight_m), 0.0,
+                  kGarageReflectivity});
 }
 }  // namespace
 
@@ -116,10 +136,10 @@ World build_racetrack_world() {
 
   World w;
   Rng rng(kLayoutSeed);
-  add_wall_along(w.scene, path, kBarrierOffset_m, kBarrierStep_m, kBarrierHeight_m, kBarrierThickness_m, 0.5F, 0.0, rng);
-  add_wall_along(w.scene, path, -kBarrierOffset_m, kBarrierStep_m, kBarrierHeight_m, kBarrierThickness_m, 0.5F, 0.0, rng);
-  add_wall_along(w.scene, path, kFenceOffset_m, kFenceStep_m, kFenceHeight_m, kFenceThickness_m, 0.25F, kFenceGapChance, rng);
-  add_wall_along(w.scene, path, -kFenceOffset_m, kFenceStep_m, kFenceHeight_m, kFenceThickness_m, 0.25F, kFenceGapChance, rng);
+  add_wall_along(w.scene, path, kBarrierOffset_m, kBarrierStep_m, kBarrierHeight_m, kBarrierThickness_m, kBarrierReflectivity, 0.0, rng);
+  add_wall_along(w.scene, path, -kBarrierOffset_m, kBarrierStep_m, kBarrierHeight_m, kBarrierThickness_m, kBarrierReflectivity, 0.0, rng);
+  add_wall_along(w.scene, path, kFenceOffset_m, kFenceStep_m, kFenceHeight_m, kFenceThickness_m, kFenceReflectivity, kFenceGapChance, rng);
+  add_wall_along(w.scene, path, -kFenceOffset_m, kFenceStep_m, kFenceHeight_m, kFenceThickness_m, kFenceReflectivity, kFenceGapChance, rng);
   add_trackside_objects(w.scene, path, rng);
   add_buildings(w.scene);
   w.scene.build_index(kGridCell_m);
