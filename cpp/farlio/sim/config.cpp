@@ -1,0 +1,63 @@
+#include "farlio/sim/config.hpp"
+
+#include <stdexcept>
+
+namespace farlio::sim {
+namespace {
+constexpr std::int64_t kDefaultStartStamp_ns = 1'700'000'000'000'000'000;
+constexpr double kGravity_m_s2 = 9.81;
+
+struct ProfileDefaults {
+  double duration_s, lidar_rate_hz, imu_rate_hz;
+  NoiseConfig noise;
+};
+
+ProfileDefaults defaults_of(Profile p) {
+  switch (p) {
+    case Profile::Racetrack:  // engine and kerb vibration: high IMU noise
+      return {80.0, 20.0, 800.0,  // a little more than one 76 s lap
+              NoiseConfig{0.02, 0.02, 0.02, 0.5, 2e-4, 2e-3, Eigen::Vector3d(0.003, -0.002, 0.001),
+                          Eigen::Vector3d(0.08, -0.05, 0.06)}};
+    case Profile::Urban:
+      return {120.0, 10.0, 100.0,
+              NoiseConfig{0.02, 0.01, 0.003, 0.05, 2e-5, 3e-4, Eigen::Vector3d(0.001, -0.0015, 0.0008),
+                          Eigen::Vector3d(0.04, 0.03, -0.05)}};
+    case Profile::Handheld:
+      return {90.0, 10.0, 200.0,
+              NoiseConfig{0.01, 0.01, 0.005, 0.08, 4e-5, 6e-4, Eigen::Vector3d(-0.002, 0.001, 0.0015),
+                          Eigen::Vector3d(-0.06, 0.04, 0.05)}};
+  }
+  throw std::invalid_argument("unknown profile");
+}
+}  // namespace
+
+Profile parse_profile(const std::string& name) {
+  if (name == "racetrack") return Profile::Racetrack;
+  if (name == "urban") return Profile::Urban;
+  if (name == "handheld") return Profile::Handheld;
+  throw std::invalid_argument("unknown simulation profile '" + name + "' (valid: racetrack, urban, handheld)");
+}
+
+std::string profile_name(Profile profile) {
+  switch (profile) {
+    case Profile::Racetrack: return "racetrack";
+    case Profile::Urban: return "urban";
+    case Profile::Handheld: return "handheld";
+  }
+  throw std::invalid_argument("unknown profile");
+}
+
+SimConfig default_config(Profile profile) {
+  const ProfileDefaults d = defaults_of(profile);
+  SimConfig c;
+  c.profile = profile;
+  c.duration_s = d.duration_s;
+  c.noise = d.noise;
+  c.start_stamp_ns = kDefaultStartStamp_ns;
+  c.lidar_rate_hz = d.lidar_rate_hz;
+  c.imu_rate_hz = d.imu_rate_hz;
+  c.gravity_m_s2 = kGravity_m_s2;
+  return c;
+}
+
+}  // namespace farlio::sim

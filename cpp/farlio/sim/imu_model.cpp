@@ -1,0 +1,48 @@
+#include "farlio/sim/imu_model.hpp"
+
+#include <cmath>
+
+#include "farlio/sim/random.hpp"
+
+namespace farlio::sim {
+namespace {
+constexpr double kNsPerS = 1e9;
+
+Eigen::Vector3d gaussian3(std::uint64_t seed, Stream stream, std::uint64_t index) {
+  return {standard_normal(seed, stream, index, 0), standard_normal(seed, stream, index, 1),
+          standard_normal(seed, stream, index, 2)};
+}
+}  // namespace
+
+ImuSample ideal_imu_reading(const BodyState& s, double gravity_m_s2) {
+  const Eigen::Vector3d g_world(0.0, 0.0, -gravity_m_s2);
+  ImuSample out;
+  out.gyro_rad_s = s.angular_velocity_body_rad_s;
+  out.accel_m_s2 = s.pose_world_body.rotation().transpose() * (s.acceleration_world_m_s2 - g_world);
+  return out;
+}
+
+std::vector<ImuSample> generate_imu(const MotionModel& motion, const SimConfig& config) {
+  const auto count = static_cast<std::size_t>(std::floor(config.duration_s * config.imu_rate_hz)) + 1;
+  const double dt_s = 1.0 / config.imu_rate_hz;
+  const NoiseConfig& n = config.noise;
+  Eigen::Vector3d gyro_bias = n.gyro_bias_initial_rad_s, accel_bias = n.accel_bias_initial_m_s2;
+  std::vector<ImuSample> out;
+  out.reserve(count);
+  for (std::size_t k = 0; k < count; ++k) {
+    const double t_s = static_cast<double>(k) * dt_s;
+    ImuSample s = ideal_imu_reading(motion.state(t_s), config.gravity_m_s2);
+    s.stamp_ns = config.start_stamp_ns + std::llround(t_s * kNsPerS);
+    if (!config.noise_free) {
+      s.gyro_rad_s += gyro_bias + n.gyro_noise_std_rad_s * gaussian3(config.seed, Stream::ImuGyro, k);
+      s.accel_m_s2 += accel_bias + n.accel_noise_std_m_s2 * gaussian3(config.seed, Stream::ImuAccel, k);
+      const double sqrt_dt = std::sqrt(dt_s);
+      gyro_bias += n.gyro_bias_walk_rad_s2_sqrt_hz * sqrt_dt * gaussian3(config.seed, Stream::ImuGyroBias, k);
+      accel_bias += n.accel_bias_walk_m_s3_sqrt_hz * sqrt_dt * gaussian3(config.seed, Stream::ImuAccelBias, k);
+    }
+    out.push_back(s);
+  }
+  return out;
+}
+
+}  // namespace farlio::sim

@@ -1,0 +1,20 @@
+#pragma once
+// The IMU model: samples the exact body motion (gyro = body angular velocity, accel =
+// R_wb^T (a_world - g_world) with g_world = (0, 0, -gravity)) and adds a bias random walk and
+// white noise per sample, unless noise-free.
+#include <cstdint>
+#include <vector>
+
+#include "farlio/core/types.hpp"
+#include "farlio/sim/config.hpp"
+#include "farlio/sim/motion.hpp"
+
+namespace farlio::sim {
+
+/// The noise-free reading of an ideal IMU in state `s`.
+ImuSample ideal_imu_reading(const BodyState& s, double gravity_m_s2);
+
+/// Samples at start_stamp_ns + k / rate for k = 0 .. floor(duration * rate), in time order.
+std::vector<ImuSample> generate_imu(const MotionModel& motion, const SimConfig& config);
+
+}  // namespace farlio::sim

@@ -1,0 +1,24 @@
+#include "farlio/sim/world.hpp"
+
+#include <stdexcept>
+
+namespace farlio::sim {
+
+World build_world(Profile profile) {
+  switch (profile) {
+    case Profile::Racetrack: return build_racetrack_world();
+    case Profile::Urban: return build_urban_world();
+    case Profile::Handheld: return build_handheld_world();
+  }
+  throw std::invalid_argument("unknown profile");
+}
+
+SE3 mount_pose(const Eigen::Vector3d& offset_m, double yaw_rad, double pitch_rad, double roll_rad) {
+  EulerZyx e;
+  e.yaw_rad = yaw_rad;
+  e.pitch_rad = pitch_rad;
+  e.roll_rad = roll_rad;
+  return {euler_zyx_rotation(e), offset_m};
+}
+
+}  // namespace farlio::sim

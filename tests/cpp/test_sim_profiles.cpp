@@ -1,0 +1,140 @@
+// The profiles' trajectories stay within their stated ranges, and the configuration API.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "farlio/sim/sequence_generator.hpp"
+
+using namespace farlio;
+using namespace farlio::sim;
+
+namespace {
+constexpr double kSampleRate_hz = 50.0;
+constexpr double kEps = 1e-6;
+
+struct Extremes {
+  double max_speed_m_s = 0.0, min_speed_m_s = 1e9, max_lateral_m_s2 = 0.0, max_rate_rad_s = 0.0;
+  double z_min_m = 1e9, z_max_m = -1e9, standstill_s = 0.0;
+};
+
+Extremes sample(const SequenceGenerator& gen, double duration_s) {
+  Extremes e;
+  for (double t = 0.0; t <= duration_s; t += 1.0 / kSampleRate_hz) {
+    const BodyState s = gen.state(gen.config().start_stamp_ns + std::llround(t * 1e9));
+    const double v = s.velocity_world_m_s.norm();
+    e.max_speed_m_s = std::max(e.max_speed_m_s, v);
+    e.min_speed_m_s = std::min(e.min_speed_m_s, v);
+    if (v > kEps) e.max_lateral_m_s2 = std::max(e.max_lateral_m_s2, s.acceleration_world_m_s2.cross(s.velocity_world_m_s).norm() / v);
+    if (v < kEps) e.standstill_s += 1.0 / kSampleRate_hz;
+    e.max_rate_rad_s = std::max(e.max_rate_rad_s, s.angular_velocity_body_rad_s.norm());
+    e.z_min_m = std::min(e.z_min_m, s.pose_world_body.translation().z());
+    e.z_max_m = std::max(e.z_max_m, s.pose_world_body.translation().z());
+  }
+  return e;
+}
+}  // namespace
+
+TEST(SimProfiles, RacetrackSpeedAndCornering) {
+  SimConfig cfg = default_config(Profile::Racetrack);
+  cfg.duration_s = 120.0;  // more than a lap
+  const SequenceGenerator gen(cfg);
+  const Extremes e = sample(gen, cfg.duration_s);
+  EXPECT_GE(e.max_speed_m_s, 60.0);
+  EXPECT_LE(e.max_speed_m_s, 70.0 + 1e-3);
+  EXPECT_GE(e.max_lateral_m_s2, 15.0);
+  EXPECT_LE(e.max_lateral_m_s2, 27.0);
+  EXPECT_GT(e.min_speed_m_s, 20.0) << "a race car never stops";
+  const double lap_m = std::stod(gen.description().at("lap_length_m"));
+  EXPECT_GT(lap_m, 3000.0);
+  // The circuit is closed: one lap later the car is back where it was.
+  const double lap_s = std::stod(gen.description().at("lap_time_s"));
+  const auto p0 = gen.state(cfg.start_stamp_ns + std::llround(1e9)).pose_world_body;
+  const auto p1 = gen.state(cfg.start_stamp_ns + std::llround((1.0 + lap_s) * 1e9)).pose_world_body;
+  EXPECT_LT((p0.translation() - p1.translation()).norm(), 1e-3);
+}
+
+TEST(SimProfiles, UrbanHasStopsTurnsAndSlopes) {
+  const SimConfig cfg = default_config(Profile::Urban);
+  const SequenceGenerator gen(cfg);
+  const Extremes e = sample(gen, cfg.duration_s);
+  EXPECT_GE(e.max_speed_m_s, 12.0);
+  EXPECT_LE(e.max_speed_m_s, 15.0 + 1e-3);
+  EXPECT_GT(e.standstill_s, 5.0) << "full stops";
+  EXPECT_GT(e.z_max_m - e.z_min_m, 3.0) << "the road goes up and down";
+  EXPECT_GT(e.max_rate_rad_s, 0.3) << "turns";
+  EXPECT_LE(e.max_lateral_m_s2, 4.5 + 0.1);
+}
+
+TEST(SimProfiles, HandheldWalksAndTurnsQuickly) {
+  const SimConfig cfg = default_config(Profile::Handheld);
+  const SequenceGenerator gen(cfg);
+  const Extremes e = sample(gen, cfg.duration_s);
+  EXPECT_GE(e.max_rate_rad_s, 2.0);
+  EXPECT_LE(e.max_rate_rad_s, 3.0 + 1e-3);
+  EXPECT_GE(e.max_speed_m_s, 1.2);
+  EXPECT_LE(e.max_speed_m_s, 2.0);
+  EXPECT_GT(e.z_max_m - e.z_min_m, 0.02) << "walking bob";
+  EXPECT_LT(e.z_max_m - e.z_min_m, 0.1);
+}
+
+TEST(SimProfiles, GroundTruthTrajectories) {
+  SimConfig cfg = default_config(Profile::Urban);
+  cfg.duration_s = 3.0;
+  const SequenceGenerator gen(cfg);
+  const Trajectory body = gen.groundtruth_body(100.0);
+  EXPECT_EQ(body.size(), 301U);
+  EXPECT_TRUE(body.is_time_ordered());
+  const Trajectory scans = gen.groundtruth_scans();
+  ASSERT_EQ(scans.size(), gen.num_scans());
+  EXPECT_EQ(gen.num_scans(), 30U);
+  for (std::size_t i = 0; i < scans.size(); ++i) {
+    EXPECT_EQ(scans[i].stamp_ns, gen.scan_start_ns(i) + gen.scan_period_ns());
+    EXPECT_LT((scans[i].pose.translation() - gen.state(scans[i].stamp_ns).pose_world_body.translation()).norm(), 1e-12);
+  }
+}
+
+TEST(SimProfiles, VelocityIsTheDerivativeOfPosition) {
+  // Central differences of the exact poses agree with the analytic velocity and rate.
+  for (const Profile p : {Profile::Racetrack, Profile::Urban, Profile::Handheld}) {
+    const SequenceGenerator gen(default_config(p));
+    constexpr std::int64_t kStep_ns = 1'000'000;
+    for (const double t : {0.3, 3.7, 11.1, 25.9, 47.3}) {
+      const std::int64_t stamp = gen.config().start_stamp_ns + std::llround(t * 1e9);
+      const BodyState s = gen.state(stamp), a = gen.state(stamp - kStep_ns), b = gen.state(stamp + kStep_ns);
+      const Eigen::Vector3d v_fd = (b.pose_world_body.translation() - a.pose_world_body.translation()) / 2e-3;
+      EXPECT_LT((v_fd - s.velocity_world_m_s).norm(), 1e-3 * (1.0 + s.velocity_world_m_s.norm())) << profile_name(p) << t;
+      const Eigen::Vector3d acc_fd = (b.velocity_world_m_s - a.velocity_world_m_s) / 2e-3;
+      EXPECT_LT((acc_fd - s.acceleration_world_m_s2).norm(), 1e-2) << profile_name(p) << t;
+      const Eigen::Vector3d w_fd =
+          so3_log(a.pose_world_body.rotation().transpose() * b.pose_world_body.rotation()) / 2e-3;
+      EXPECT_LT((w_fd - s.angular_velocity_body_rad_s).norm(), 1e-3) << profile_name(p) << t;
+    }
+  }
+}
+
+TEST(SimConfigApi, ParseProfile) {
+  EXPECT_EQ(parse_profile("racetrack"), Profile::Racetrack);
+  EXPECT_EQ(parse_profile("urban"), Profile::Urban);
+  EXPECT_EQ(parse_profile("handheld"), Profile::Handheld);
+  try {
+    (void)parse_profile("moon");
+    FAIL() << "expected an error";
+  } catch (const std::invalid_argument& e) {
+    const std::string msg = e.what();
+    for (const char* name : {"moon", "racetrack", "urban", "handheld"}) EXPECT_NE(msg.find(name), std::string::npos);
+  }
+  for (const Profile p : {Profile::Racetrack, Profile::Urban, Profile::Handheld}) EXPECT_EQ(parse_profile(profile_name(p)), p);
+}
+
+TEST(SimConfigApi, DefaultsDifferPerProfile) {
+  const SimConfig race = default_config(Profile::Racetrack), urban = default_config(Profile::Urban),
+                  hand = default_config(Profile::Handheld);
+  EXPECT_EQ(race.lidar_rate_hz, 20.0);
+  EXPECT_EQ(race.imu_rate_hz, 800.0);
+  EXPECT_EQ(urban.lidar_rate_hz, 10.0);
+  EXPECT_EQ(urban.imu_rate_hz, 100.0);
+  EXPECT_EQ(hand.imu_rate_hz, 200.0);
+  EXPECT_GT(race.noise.accel_noise_std_m_s2, urban.noise.accel_noise_std_m_s2);
+  EXPECT_GT(race.noise.gyro_noise_std_rad_s, urban.noise.gyro_noise_std_rad_s);
+  EXPECT_FALSE(race.noise_free);
+}
