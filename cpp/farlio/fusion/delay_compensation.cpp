@@ -11,7 +11,8 @@ Eigen::VectorXd shifted_measurement(MeasurementKind kind, const Eigen::VectorXd&
 }
 
 ArrivalResidual arrival_residual(MeasurementKind kind, const Eigen::VectorXd& z_s, std::int64_t stamp_ns,
-                                 const StateHistory& history, const StateVector& x_now, bool compensate) {
+                                 const StateHistory& history, const StateVector& x_now,
+                                 const StateVector& current_correction, bool compensate) {
   ArrivalResidual out;
   if (history.empty() || stamp_ns < history.oldest().stamp_ns) {
     out.rejection_reason = "measurement stamp " + std::to_string(stamp_ns) +
@@ -25,7 +26,8 @@ ArrivalResidual arrival_residual(MeasurementKind kind, const Eigen::VectorXd& z_
     out.residual = measurement_difference(kind, z_s, h_now);
     return out;
   }
-  const StateVector x_s = *history.state_at(stamp_ns);
+  const StampedState past = *history.entry_at(stamp_ns);
+  const StateVector x_s = normalized_state(past.x + (current_correction - past.cumulative_correction));
   out.residual = measurement_difference(kind, shifted_measurement(kind, z_s, x_s, x_now), h_now);
   return out;
 }

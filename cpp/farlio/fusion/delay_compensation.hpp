@@ -35,12 +35,17 @@ Eigen::VectorXd shifted_measurement(MeasurementKind kind, const Eigen::VectorXd&
 /// The residual at arrival of a measurement for stamp_ns: with compensation the shifted
 /// innovation (eq. 10), without it z_s - h(x_now). Empty with a reason if the stamp is older than
 /// the history (a stamp newer than the history is taken as current: no delay).
+/// With compensation, x_s is the history state moved by the corrections applied after s
+/// (current_correction - its cumulative correction): the estimate of the past state given all
+/// updates so far, as in Larsen's method, so that an update already applied after s (e.g. the
+/// last injections of the previous LiDAR result) is not applied again through this innovation.
 struct ArrivalResidual {
   std::optional<Eigen::VectorXd> residual;
   std::string rejection_reason;
 };
 ArrivalResidual arrival_residual(MeasurementKind kind, const Eigen::VectorXd& z_s, std::int64_t stamp_ns,
-                                 const StateHistory& history, const StateVector& x_now, bool compensate);
+                                 const StateHistory& history, const StateVector& x_now,
+                                 const StateVector& current_correction, bool compensate);
 
 /// Measurements accepted at arrival and fused over the following steps.
 class SpreadMeasurementQueue {

@@ -1,5 +1,7 @@
 #include "farlio/fusion/reference_angles.hpp"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>

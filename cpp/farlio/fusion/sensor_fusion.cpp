@@ -46,6 +46,12 @@ SensorFusion::SensorFusion(const FusionConfig& config, double gravity_m_s2)
 
 void SensorFusion::warn(std::string message) { stats_.last_warning = std::move(message); }
 
+void SensorFusion::record_correction(const StateVector& before) {
+  StateVector d = ekf_.state() - before;
+  for (int i = 0; i < 3; ++i) d(kAttitudeIndex + i) = wrap_angle(d(kAttitudeIndex + i));
+  cumulative_correction_ += d;
+}
+
 double SensorFusion::gate(int dim) const {
   if (!config_.outlier_rejection) return 0.0;
   return dim == 2 ? config_.outlier_chi2_2dof : config_.outlier_chi2_3dof;
@@ -96,10 +102,12 @@ void SensorFusion::step() {
   }
   ekf_.predict(u0, um, u1, static_cast<double>(step_ns_) / kNsPerS);
   time_ns_ = t1;
+  const StateVector before_injections = ekf_.state();
   queue_.inject(ekf_);
+  record_correction(before_injections);
   last_input_ = u1;
   if (config_.reference_angles) fuse_reference_angles(t1);
-  history_.push(t1, ekf_.state());
+  history_.push(t1, ekf_.state(), cumulative_correction_);
   ++stats_.steps;
   imu_.discard_before(t1);
 }
@@ -117,12 +125,14 @@ void SensorFusion::fuse_reference_angles(std::int64_t stamp_ns) {
   const Eigen::Matrix2d R =
       Eigen::Vector2d(square(config_.reference_roll_std_rad), square(config_.reference_pitch_std_rad)).asDiagonal();
   const ArrivalResidual r =
-      arrival_residual(MeasurementKind::kRollPitch, z, angles->stamp_ns, history_, x, config_.delay_compensation);
+      arrival_residual(MeasurementKind::kRollPitch, z, angles->stamp_ns, history_, x, cumulative_correction_,
+                       config_.delay_compensation);
   if (!r.residual) return;
   const StateVector before = x;
   if (ekf_.update(MeasurementKind::kRollPitch, *r.residual, R, gate(2))) {
     ++stats_.reference_angles_accepted;
     queue_.note_correction(before, ekf_.state());
+    record_correction(before);
   } else {
     ++stats_.reference_angles_rejected;
   }
@@ -140,7 +150,8 @@ void SensorFusion::initialize(std::int64_t stamp_ns, const SE3& pose, const Eige
   ekf_.initialize(x, variance.asDiagonal());
   time_ns_ = stamp_ns;
   history_.clear();
-  history_.push(stamp_ns, ekf_.state());
+  cumulative_correction_.setZero();
+  history_.push(stamp_ns, ekf_.state(), cumulative_correction_);
   queue_.clear();
   reference_.reset();
   in_gap_ = false;
@@ -180,7 +191,8 @@ LidarUpdateResult SensorFusion::add_lidar(std::int64_t measured_at_ns, const SE3
   const StateVector x_now = ekf_.state();
   std::vector<Eigen::VectorXd> residuals;
   for (const LidarGroup& g : groups) {
-    ArrivalResidual r = arrival_residual(g.kind, g.z, measured_at_ns, history_, x_now, config_.delay_compensation);
+    ArrivalResidual r = arrival_residual(g.kind, g.z, measured_at_ns, history_, x_now, cumulative_correction_,
+                                         config_.delay_compensation);
     if (!r.residual) {
       ++stats_.lidar_too_old;
       result.rejection_reason = r.rejection_reason;

@@ -87,6 +87,8 @@ class SensorFusion {
   [[nodiscard]] int spread_steps(std::int64_t measured_at_ns) const;
   [[nodiscard]] double gate(int dim) const;
   void warn(std::string message);
+  /// Adds x_after - x_before (angles wrapped) to the cumulative correction.
+  void record_correction(const StateVector& before);
 
   FusionConfig config_;
   double gravity_m_s2_;
@@ -106,6 +108,7 @@ class SensorFusion {
   std::optional<std::int64_t> last_lidar_ns_;
   int consecutive_rejections_ = 0;
   InputVector last_input_ = InputVector::Zero();
+  StateVector cumulative_correction_ = StateVector::Zero();
   FusionStats stats_;
 };
 

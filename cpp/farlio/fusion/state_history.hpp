@@ -12,6 +12,9 @@ namespace farlio::fusion {
 struct StampedState {
   std::int64_t stamp_ns = 0;
   StateVector x = StateVector::Zero();
+  /// Sum of all EKF corrections (x+ - x-, angles wrapped) applied up to this step: the
+  /// difference between two entries is what the updates in between moved the estimate.
+  StateVector cumulative_correction = StateVector::Zero();
 };
 
 class StateHistory {
@@ -19,7 +22,8 @@ class StateHistory {
   explicit StateHistory(std::size_t capacity);
 
   /// Appends a state; stamps must increase (an older or equal stamp replaces the history tail).
-  void push(std::int64_t stamp_ns, const StateVector& x);
+  void push(std::int64_t stamp_ns, const StateVector& x,
+            const StateVector& cumulative_correction = StateVector::Zero());
   void clear();
   [[nodiscard]] std::size_t size() const { return size_; }
   [[nodiscard]] bool empty() const { return size_ == 0; }
@@ -28,6 +32,8 @@ class StateHistory {
   /// The state at stamp_ns: positions and velocities interpolated linearly, the attitude
   /// geodesically (quaternion slerp); nullopt outside [oldest, newest].
   [[nodiscard]] std::optional<StateVector> state_at(std::int64_t stamp_ns) const;
+  /// The interpolated entry (state as state_at, cumulative correction linearly).
+  [[nodiscard]] std::optional<StampedState> entry_at(std::int64_t stamp_ns) const;
 
  private:
   [[nodiscard]] const StampedState& at(std::size_t i) const { return buffer_[(head_ + i) % buffer_.size()]; }
