@@ -54,12 +54,66 @@ struct RegistrationConfig {
   double damping = 1e-9;                ///< lambda added to the diagonal of H
 };
 
+/// Sensor fusion: the kinematic EKF (paper eqs. 7-10) that fuses IMU inputs with LiDAR poses.
+/// Variances are given as standard deviations (unit in the name); docs/fusion.md explains each.
+struct FusionConfig {
+  double step_s = 0.01;                  ///< fixed EKF step (paper: 100 Hz)
+  double history_s = 1.0;                ///< state history for delay compensation and pose queries
+  double max_extrapolation_s = 0.1;      ///< pose_at() may predict this far beyond the newest step
+  double imu_gap_limit_s = 0.1;          ///< IMU samples farther apart are a gap: the last input is held
+  // Input noise: std of the IMU input averaged over one step, mapped into the state as B Q B^T
+  // (reference: variances 3e-4..3e-3 rad^2/s^2 and 1.0..4.0 m^2/s^4 at 100 Hz).
+  double gyro_input_std_rad_s = 0.02;
+  double accel_input_std_m_s2 = 1.0;
+  // Initial covariance (the first LiDAR pose initialises the state).
+  double initial_position_std_m = 0.1;
+  double initial_attitude_std_rad = 0.02;
+  double initial_velocity_std_m_s = 20.0;  ///< used when the first LiDAR result carries no velocity
+  // LiDAR measurement noise (std per axis).
+  double lidar_position_std_m = 0.05;
+  double lidar_roll_pitch_std_rad = 0.02;
+  double lidar_yaw_std_rad = 0.01;
+  double lidar_velocity_std_m_s = 0.8;
+  // Mahalanobis outlier rejection per measurement group.
+  bool outlier_rejection = true;
+  double outlier_chi2_3dof = 16.27;      ///< chi-square 99.9 % quantile, 3 degrees of freedom
+  double outlier_chi2_2dof = 13.82;      ///< chi-square 99.9 % quantile, 2 degrees of freedom
+  int max_consecutive_rejections = 10;   ///< then the filter re-initialises from the LiDAR pose
+  // Roll/pitch reference angles (pseudo-measurement from gravity in the body frame).
+  bool reference_angles = true;
+  double reference_roll_std_rad = 0.22;  ///< reference: variance 0.05 rad^2
+  double reference_pitch_std_rad = 0.32; ///< reference: variance 0.1 rad^2
+  int reference_filter_taps = 11;        ///< Hann low-pass on v_dot and the IMU terms (odd)
+  double reference_max_sin = 0.5;        ///< asin argument clamp (30 deg); clamped values are not fused
+  // Delay compensation (eq. 10) and upsampling of LiDAR results.
+  bool delay_compensation = true;
+  int update_spread_steps = 0;           ///< N injections with N*R each; 0: LiDAR period / step_s
+  int max_update_spread_steps = 20;      ///< cap of the automatic N
+  // Gyro bias at standstill (the accelerometer bias stays at its initial value, as in the paper).
+  bool standstill_bias = true;
+  double standstill_max_speed_m_s = 0.4;
+  double standstill_max_gyro_rad_s = 0.05;
+  double standstill_max_accel_deviation_m_s2 = 1.0;  ///< | |a| - g | below this
+  int bias_window_samples = 10000;       ///< running mean over at most this many samples
+  int bias_prior_samples = 100;          ///< weight of the initial bias in the mean, in samples
+  double gyro_bias_init_x_rad_s = 0.0;
+  double gyro_bias_init_y_rad_s = 0.0;
+  double gyro_bias_init_z_rad_s = 0.0;
+  double accel_bias_x_m_s2 = 0.0;
+  double accel_bias_y_m_s2 = 0.0;
+  double accel_bias_z_m_s2 = 0.0;
+  // Accelerometer unit detection (IMUs reporting in g).
+  bool accel_unit_detection = true;
+  int accel_unit_detection_samples = 50; ///< mean |a| over these first samples decides the unit
+};
+
 struct Config {
   PreprocessConfig preprocess;
   VoxelMapConfig map;
   AdaptiveDensityConfig density;
   ThresholdConfig threshold;
   RegistrationConfig registration;
+  FusionConfig fusion;
   int num_threads = 0;                  ///< CPU threads of this pipeline instance (0: all)
 };
 

@@ -1,0 +1,50 @@
+#pragma once
+// The kinematic motion model of the EKF (paper eqs. 7-8): state, input, continuous dynamics,
+// their analytic Jacobians and one integration step.
+//   x = [p_world (3), roll/pitch/yaw ZYX (3), v_body (3)],  u = [a_m (3), omega_m (3)]
+//   p'     = R(theta) v
+//   theta' = E(theta) omega
+//   v'     = a_m - omega x v + R(theta)^T g_world,  g_world = (0, 0, -g)
+// u is the bias-corrected IMU input (specific force, angular rate) in the body frame.
+#include <Eigen/Core>
+
+namespace farlio::fusion {
+
+inline constexpr int kStateDim = 9;
+inline constexpr int kInputDim = 6;
+inline constexpr int kPositionIndex = 0;  ///< p_world in the state
+inline constexpr int kAttitudeIndex = 3;  ///< roll, pitch, yaw in the state
+inline constexpr int kVelocityIndex = 6;  ///< v_body in the state
+inline constexpr int kAccelIndex = 0;     ///< a_m in the input
+inline constexpr int kGyroIndex = 3;      ///< omega_m in the input
+/// |cos(pitch)| is clamped to at least this in E(theta) (the gimbal lock at +-90 deg).
+inline constexpr double kMinCosPitch = 1e-9;
+
+using StateVector = Eigen::Matrix<double, kStateDim, 1>;
+using StateMatrix = Eigen::Matrix<double, kStateDim, kStateDim>;
+using InputVector = Eigen::Matrix<double, kInputDim, 1>;
+using InputMatrix = Eigen::Matrix<double, kStateDim, kInputDim>;
+
+/// u from its parts.
+InputVector make_input(const Eigen::Vector3d& accel_m_s2, const Eigen::Vector3d& gyro_rad_s);
+
+/// f(x, u): the state derivative.
+StateVector state_derivative(const StateVector& x, const InputVector& u, double gravity_m_s2);
+
+/// df/dx and df/du at (x, u), analytic.
+struct ModelJacobians {
+  StateMatrix df_dx = StateMatrix::Zero();
+  InputMatrix df_du = InputMatrix::Zero();
+};
+ModelJacobians model_jacobians(const StateVector& x, const InputVector& u, double gravity_m_s2);
+
+/// One classical Runge-Kutta (RK4) step of length dt_s with the input at the step start, the
+/// step middle and the step end. The angles of the result are wrapped (pitch kept in
+/// [-pi/2, pi/2] by re-deriving the angles from the rotation if it leaves that range).
+StateVector integrate_step(const StateVector& x, const InputVector& u_start, const InputVector& u_mid,
+                           const InputVector& u_end, double dt_s, double gravity_m_s2);
+
+/// Wraps the angles of x (see integrate_step).
+StateVector normalized_state(const StateVector& x);
+
+}  // namespace farlio::fusion

@@ -1,0 +1,32 @@
+#pragma once
+// The linear-selector measurement models h(x) of the EKF (paper eq. 9): each measurement group
+// observes a contiguous block of the state; angle groups have wrapped residuals.
+#include <Eigen/Core>
+
+#include "farlio/fusion/kinematic_model.hpp"
+
+namespace farlio::fusion {
+
+enum class MeasurementKind {
+  kPosition,     ///< p_world (3), m
+  kOrientation,  ///< roll, pitch, yaw (3), rad
+  kVelocity,     ///< v_body (3), m/s
+  kRollPitch,    ///< roll, pitch (2), rad: the reference angles
+};
+
+struct MeasurementSlot {
+  int first_state_index = 0;
+  int dim = 0;
+  bool is_angle = false;
+};
+
+MeasurementSlot slot_of(MeasurementKind kind);
+/// h(x) for the group.
+Eigen::VectorXd measure(MeasurementKind kind, const StateVector& x);
+/// a - b for two values of the group (angles wrapped into (-pi, pi]).
+Eigen::VectorXd measurement_difference(MeasurementKind kind, const Eigen::VectorXd& a, const Eigen::VectorXd& b);
+/// H: the selector matrix of the group.
+Eigen::MatrixXd measurement_jacobian(MeasurementKind kind);
+const char* kind_name(MeasurementKind kind);
+
+}  // namespace farlio::fusion

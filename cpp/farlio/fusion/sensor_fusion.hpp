@@ -1,0 +1,115 @@
+#pragma once
+// The sensor-fusion front (paper Sec. "Sensor Fusion"): IMU samples in, LiDAR results in, the
+// fused body odometry out. Deterministic and clock-free: time only advances through
+// advance_to(), on a fixed grid of FusionConfig::step_s anchored at the initialisation stamp.
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "farlio/core/config.hpp"
+#include "farlio/core/se3.hpp"
+#include "farlio/core/types.hpp"
+#include "farlio/fusion/accel_unit_detector.hpp"
+#include "farlio/fusion/delay_compensation.hpp"
+#include "farlio/fusion/imu_buffer.hpp"
+#include "farlio/fusion/kinematic_ekf.hpp"
+#include "farlio/fusion/reference_angles.hpp"
+#include "farlio/fusion/standstill_bias.hpp"
+#include "farlio/fusion/state_history.hpp"
+
+namespace farlio::fusion {
+
+struct BodyEstimate {
+  bool valid = false;                    ///< false before initialisation
+  std::int64_t stamp_ns = 0;             ///< the filter time (the last step)
+  SE3 pose;                              ///< body -> world
+  Eigen::Vector3d velocity_body_m_s = Eigen::Vector3d::Zero();
+  /// Variances of [p (m^2), roll/pitch/yaw (rad^2), v_body (m^2/s^2)].
+  Eigen::Matrix<double, kStateDim, 1> covariance_diagonal = Eigen::Matrix<double, kStateDim, 1>::Zero();
+};
+
+struct FusionStats {
+  std::int64_t steps = 0;
+  std::int64_t lidar_groups_accepted = 0;   ///< position / orientation / velocity groups
+  std::int64_t lidar_groups_rejected = 0;   ///< by the Mahalanobis gate
+  std::int64_t lidar_too_old = 0;           ///< older than the state history: rejected
+  std::int64_t reinitializations = 0;       ///< after max_consecutive_rejections
+  std::int64_t reference_angles_accepted = 0;
+  std::int64_t reference_angles_rejected = 0;  ///< gated or saturated
+  std::int64_t imu_gaps = 0;                ///< gap events (each held-input stretch counts once)
+  std::int64_t imu_samples_dropped = 0;     ///< older than the newest sample
+  bool accel_in_g = false;                  ///< the accelerometer was detected to report in g
+  std::string accel_unit_message;           ///< printable note when accel_in_g
+  Eigen::Vector3d gyro_bias_rad_s = Eigen::Vector3d::Zero();
+  std::int64_t bias_samples = 0;
+  std::string last_warning;                 ///< the most recent warning, empty if none
+};
+
+/// Which groups of one LiDAR result were accepted.
+struct LidarUpdateResult {
+  bool position_accepted = false;
+  bool orientation_accepted = false;
+  bool velocity_accepted = false;  ///< false as well when no velocity was given
+  bool initialized_filter = false; ///< this result (re-)initialised the filter
+  std::string rejection_reason;    ///< set when the whole result was rejected
+};
+
+class SensorFusion {
+ public:
+  SensorFusion(const FusionConfig& config, double gravity_m_s2);
+
+  /// Any rate; a sample older than the newest one is dropped and counted.
+  void add_imu(const ImuSample& sample);
+  /// Steps the filter to stamp_ns (as many whole steps as fit). Before initialisation only the
+  /// clock moves.
+  void advance_to(std::int64_t stamp_ns);
+  /// A LiDAR result for the scan-end stamp measured_at_ns, delivered at the current filter time
+  /// (the difference is its delay). The first one initialises the filter.
+  LidarUpdateResult add_lidar(std::int64_t measured_at_ns, const SE3& body_pose,
+                              const Eigen::Vector3d& body_velocity_m_s, bool use_velocity);
+
+  [[nodiscard]] bool initialized() const { return ekf_.initialized(); }
+  [[nodiscard]] BodyEstimate estimate() const;
+  /// The pose at stamp_ns from the history, or predicted with the last input up to
+  /// max_extrapolation_s beyond the newest step; nullopt otherwise.
+  [[nodiscard]] std::optional<SE3> pose_at(std::int64_t stamp_ns) const;
+  /// The bias-corrected angular rate used in the last step (rad/s, body frame).
+  [[nodiscard]] Eigen::Vector3d angular_velocity_body() const { return last_input_.segment<3>(kGyroIndex); }
+  [[nodiscard]] FusionStats stats() const;
+
+ private:
+  void initialize(std::int64_t stamp_ns, const SE3& pose, const Eigen::Vector3d& velocity, bool velocity_known);
+  void step();
+  [[nodiscard]] InputVector input_of(const ImuReading& r) const;
+  void fuse_reference_angles(std::int64_t stamp_ns);
+  [[nodiscard]] int spread_steps(std::int64_t measured_at_ns) const;
+  [[nodiscard]] double gate(int dim) const;
+  void warn(std::string message);
+  /// Adds x_after - x_before (angles wrapped) to the cumulative correction.
+  void record_correction(const StateVector& before);
+
+  FusionConfig config_;
+  double gravity_m_s2_;
+  std::int64_t step_ns_;
+  KinematicEkf ekf_;
+  ImuBuffer imu_;
+  AccelUnitDetector accel_unit_;
+  StandstillGyroBias bias_;
+  ReferenceAngleEstimator reference_;
+  StateHistory history_;
+  SpreadMeasurementQueue queue_;
+  Eigen::Vector3d accel_bias_m_s2_;
+  std::int64_t time_ns_ = 0;   ///< filter time (valid once initialised)
+  std::int64_t clock_ns_ = 0;  ///< the latest advance_to stamp
+  bool clock_set_ = false;
+  bool in_gap_ = false;
+  std::optional<std::int64_t> last_lidar_ns_;
+  int consecutive_rejections_ = 0;
+  InputVector last_input_ = InputVector::Zero();
+  StateVector cumulative_correction_ = StateVector::Zero();
+  FusionStats stats_;
+};
+
+}  // namespace farlio::fusion
