@@ -4,9 +4,11 @@
 #include <nanobind/stl/string.h>
 #include <nanobind/stl/tuple.h>
 #include <nanobind/stl/vector.h>
+#include <nanobind/stl/pair.h>
 
 #include "bindings.hpp"
 #include "farlio/core/config_fields.hpp"
+#include "farlio/pipeline/odometry.hpp"
 #include "farlio/pipeline/pairwise.hpp"
 #include "farlio/pipeline/scan_pipeline.hpp"
 
@@ -14,6 +16,27 @@ namespace nb = nanobind;
 using namespace nb::literals;
 
 namespace farlio::python {
+namespace {
+
+/// Odometry with its 10 ms output collected between calls (no Python callback on the hot path).
+struct PyOdometry {
+  std::vector<pipeline::OdometrySample> pending;
+  pipeline::Odometry odometry;
+  PyOdometry(const Config& c, const SE3& T, double g, std::vector<ImuSample> imu, const pipeline::ReplayOptions& o)
+      : odometry(c, T, g, std::move(imu), o) {
+    odometry.on_odometry = [this](const pipeline::OdometrySample& s) { pending.push_back(s); };
+  }
+};
+
+Eigen::MatrixX3f map_points(const map::VoxelMap& m) {
+  std::vector<Eigen::Vector3f> pts;
+  m.for_each_point([&](const Eigen::Vector3f& x, const map::Cov3&, bool) { pts.push_back(x); });
+  Eigen::MatrixX3f out(static_cast<Eigen::Index>(pts.size()), 3);
+  for (std::size_t i = 0; i < pts.size(); ++i) out.row(static_cast<Eigen::Index>(i)) = pts[i].transpose();
+  return out;
+}
+
+}  // namespace
 
 void bind_pipeline(nb::module_& m) {
   nb::class_<Config>(m, "Config", "The one parameter set; fields by dotted name, e.g. 'map.voxel_size_m'.")
@@ -83,6 +106,64 @@ void bind_pipeline(nb::module_& m) {
       "source"_a, "target"_a, "initial_guess"_a = SE3(), "config"_a = Config(), nb::call_guard<nb::gil_scoped_release>(),
       "T_target_source by sparsity-aware GICP (the target becomes a voxel map).");
 
+  nb::enum_<pipeline::LatencyModel>(m, "LatencyModel")
+      .value("Measured", pipeline::LatencyModel::Measured)
+      .value("Zero", pipeline::LatencyModel::Zero)
+      .value("Fixed", pipeline::LatencyModel::Fixed);
+  nb::class_<pipeline::ReplayOptions>(m, "ReplayOptions", "Latency model of the deterministic replay.")
+      .def(nb::init<>())
+      .def_rw("latency", &pipeline::ReplayOptions::latency)
+      .def_rw("fixed_latency_s", &pipeline::ReplayOptions::fixed_latency_s)
+      .def_rw("added_delay_s", &pipeline::ReplayOptions::added_delay_s);
+  nb::class_<pipeline::OdometryFrame>(m, "OdometryFrame", "What happened to one scan in the LIO replay.")
+      .def_ro("scan", &pipeline::OdometryFrame::scan)
+      .def_ro("body_pose", &pipeline::OdometryFrame::body_pose)
+      .def_ro("processed", &pipeline::OdometryFrame::processed)
+      .def_ro("fused", &pipeline::OdometryFrame::fused)
+      .def_ro("drop_reason", &pipeline::OdometryFrame::drop_reason)
+      .def_ro("started_ns", &pipeline::OdometryFrame::started_ns)
+      .def_ro("available_ns", &pipeline::OdometryFrame::available_ns)
+      .def_ro("guess_from_fusion", &pipeline::OdometryFrame::guess_from_fusion);
+  nb::class_<fusion::FusionStats>(m, "FusionStats")
+      .def_ro("steps", &fusion::FusionStats::steps)
+      .def_ro("lidar_groups_accepted", &fusion::FusionStats::lidar_groups_accepted)
+      .def_ro("lidar_groups_rejected", &fusion::FusionStats::lidar_groups_rejected)
+      .def_ro("reinitializations", &fusion::FusionStats::reinitializations)
+      .def_ro("imu_gaps", &fusion::FusionStats::imu_gaps)
+      .def_ro("imu_samples_dropped", &fusion::FusionStats::imu_samples_dropped)
+      .def_ro("accel_in_g", &fusion::FusionStats::accel_in_g)
+      .def_ro("accel_unit_message", &fusion::FusionStats::accel_unit_message)
+      .def_ro("gyro_bias_rad_s", &fusion::FusionStats::gyro_bias_rad_s)
+      .def_ro("last_warning", &fusion::FusionStats::last_warning);
+  nb::class_<PyOdometry>(m, "Odometry",
+                         "LiDAR-inertial odometry replayed on a simulated clock (LiDAR-only without IMU).")
+      .def(nb::init<const Config&, const SE3&, double, std::vector<ImuSample>, const pipeline::ReplayOptions&>(),
+           "config"_a, "T_imu_lidar"_a, "gravity_m_s2"_a, "imu"_a, "options"_a = pipeline::ReplayOptions())
+      .def(
+          "process", [](PyOdometry& o, const Scan& s) { return o.odometry.process(s); }, "scan"_a,
+          nb::call_guard<nb::gil_scoped_release>())
+      .def(
+          "finish", [](PyOdometry& o, std::int64_t t) { o.odometry.finish(t); }, "stamp_ns"_a,
+          nb::call_guard<nb::gil_scoped_release>())
+      .def(
+          "take_odometry",
+          [](PyOdometry& o) {
+            std::vector<std::pair<std::int64_t, SE3>> out;
+            for (const auto& s : o.pending) out.emplace_back(s.stamp_ns, s.body_pose);
+            o.pending.clear();
+            return out;
+          },
+          "[(stamp_ns, body pose)] of the 10 ms odometry output since the last call.")
+      .def_prop_ro("inertial", [](const PyOdometry& o) { return o.odometry.inertial(); })
+      .def_prop_ro("fusion_stats", [](const PyOdometry& o) { return o.odometry.fusion_stats(); })
+      .def_prop_ro("initial_body_pose", [](const PyOdometry& o) { return o.odometry.initial_body_pose(); })
+      .def(
+          "map_points",
+[](const PyOdometry& o) { return map_points(o.odometry.scan_pipeline().local_map()); },
+          "(N, 3) float32 copy of the submap's points (world frame)")
+      .def_prop_ro("map_memory_bytes",
+                   [](const PyOdometry& o) { return o.odometry.scan_pipeline().local_map().memory_bytes(); });
+
   nb::class_<pipeline::ScanPipeline>(m, "ScanPipeline",
                                      "preprocess -> sparsity-aware GICP against the adaptive submap -> map update")
       .def(nb::init<const Config&, const SE3&>(), "config"_a = Config(), "initial_pose"_a = SE3())
@@ -96,13 +177,7 @@ void bind_pipeline(nb::module_& m) {
       .def_prop_ro("frames", &pipeline::ScanPipeline::frames)
       .def(
           "map_points",
-          [](const pipeline::ScanPipeline& p) {
-            std::vector<Eigen::Vector3f> pts;
-            p.local_map().for_each_point([&](const Eigen::Vector3f& x, const map::Cov3&, bool) { pts.push_back(x); });
-            Eigen::MatrixX3f out(static_cast<Eigen::Index>(pts.size()), 3);
-            for (std::size_t i = 0; i < pts.size(); ++i) out.row(static_cast<Eigen::Index>(i)) = pts[i].transpose();
-            return out;
-          },
+[](const pipeline::ScanPipeline& p) { return map_points(p.local_map()); },
           "(N, 3) float32 copy of the submap's points (world frame)")
       .def_prop_ro("map_memory_bytes", [](const pipeline::ScanPipeline& p) { return p.local_map().memory_bytes(); });
 }

@@ -35,7 +35,7 @@ def test_lidar_only_odometry_on_generated_sequences(tmp_path, profile, duration,
     assert acc["kitti_rpe"]["translation_pct"] < rpe_bound
     # outputs say their frame and are complete
     for name in ("scans_lidar.tum", "scans_body.tum", "scans_lidar_kitti.txt", "timing.csv", "summary.json",
-                 "config.yaml", "eval.json"):
+                 "config.yaml", "eval_scans/eval.json"):
         assert (tmp_path / "out" / name).exists(), name
     assert len(_core.io.read_tum(tmp_path / "out" / "scans_body.tum")) == summary["processed"]
 

@@ -11,6 +11,7 @@ namespace farlio {
 struct PreprocessConfig {
   double min_range_m = 1.0;     ///< points closer than this to the sensor are dropped (vehicle body)
   double max_range_m = 200.0;   ///< points farther than this are dropped
+  bool undistort = true;        ///< motion undistortion (MU) of points with per-point times
 };
 
 /// The voxel hash map (cuVoxelMap): the adaptive local submap and the per-scan frame map.
@@ -57,6 +58,7 @@ struct RegistrationConfig {
 /// Sensor fusion: the kinematic EKF (paper eqs. 7-10) that fuses IMU inputs with LiDAR poses.
 /// Variances are given as standard deviations (unit in the name); docs/fusion.md explains each.
 struct FusionConfig {
+  bool enabled = true;                   ///< fuse the IMU (LIO); false or no IMU: LiDAR-only odometry
   double step_s = 0.01;                  ///< fixed EKF step (paper: 100 Hz)
   double history_s = 1.0;                ///< state history for delay compensation and pose queries
   double max_extrapolation_s = 0.1;      ///< pose_at() may predict this far beyond the newest step

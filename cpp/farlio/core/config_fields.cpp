@@ -11,6 +11,7 @@ std::vector<ConfigField> config_fields(Config& c) {
   return {
       {"preprocess.min_range_m", &c.preprocess.min_range_m, "points closer to the sensor are dropped"},
       {"preprocess.max_range_m", &c.preprocess.max_range_m, "points farther from the sensor are dropped"},
+      {"preprocess.undistort", &c.preprocess.undistort, "motion undistortion of points with per-point times"},
       {"map.voxel_size_m", &c.map.voxel_size_m, "edge of a voxel of the submap (paper: 4 m)"},
       {"map.max_points_per_voxel", &c.map.max_points_per_voxel,
        "N_max; the point spacing is voxel_size_m / sqrt(N_max) (paper: 40)"},
@@ -36,6 +37,7 @@ std::vector<ConfigField> config_fields(Config& c) {
       {"registration.convergence_norm", &c.registration.convergence_norm, "stop when |dx| falls below this"},
       {"registration.time_budget_factor", &c.registration.time_budget_factor, "time budget in LiDAR periods"},
       {"registration.damping", &c.registration.damping, "lambda added to the diagonal of H"},
+      {"fusion.enabled", &c.fusion.enabled, "fuse the IMU (LIO); false or no IMU: LiDAR-only odometry"},
       {"fusion.step_s", &c.fusion.step_s, "fixed EKF step (paper: 0.01 s = 100 Hz)"},
       {"fusion.history_s", &c.fusion.history_s, "state history kept for delay compensation and pose queries"},
       {"fusion.max_extrapolation_s", &c.fusion.max_extrapolation_s, "pose_at() may predict this far beyond the newest step"},

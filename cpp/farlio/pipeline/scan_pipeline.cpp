@@ -64,7 +64,7 @@ FrameResult ScanPipeline::process(const Scan& scan, const std::optional<SE3>& in
   const deskew::ScanMotion scan_motion =
       motion ? *motion
              : deskew::ScanMotion::constant_twist(last_twist().cast<float>(), static_cast<float>(scan.duration_s()));
-  const bool undistort = scan.has_time() && !scan_motion.is_identity();
+  const bool undistort = config_.preprocess.undistort && scan.has_time() && !scan_motion.is_identity();
   executor_.for_each(cropped.size(), [&](std::size_t k) {
     const auto i = static_cast<std::size_t>(cropped[k]);
     points[i] = undistort ? deskew::deskew_point(scan_motion, scan.points[i], scan.time_s[i]) : scan.points[i];

@@ -6,7 +6,7 @@ from pathlib import Path
 
 from farlio.config import load_config
 from farlio.datasets import FORMATS, open_dataset
-from farlio.runner import format_summary, run_dataset
+from farlio.runner import format_summary, replay_options, run_dataset
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -22,6 +22,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--gt", type=Path, default=None,
                         help="ground-truth body poses (TUM) to evaluate against; a sequence folder's "
                              "groundtruth_scans.tum is used by default")
+    parser.add_argument("--latency", default="measured", choices=["measured", "zero", "fixed"],
+                        help="replay latency model: a scan's result reaches the fusion after its measured "
+                             "processing time, at once, or after --fixed-latency")
+    parser.add_argument("--fixed-latency", type=float, default=0.0, metavar="S", help="latency with --latency fixed")
+    parser.add_argument("--added-delay", type=float, default=0.0, metavar="S",
+                        help="extra delay added to every result (latency sweeps)")
     parser.add_argument("--save-map", action="store_true", help="write the final submap as map.ply")
     parser.add_argument("--no-plot", action="store_true", help="do not write eval.png")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
@@ -35,7 +41,8 @@ def run(args: argparse.Namespace) -> int:
     dataset = open_dataset(args.path, args.format)
     summary = run_dataset(dataset, args.out, config, max_frames=args.max_frames, save_map=args.save_map,
                           groundtruth=args.gt, progress=False if args.no_progress else None,
-                          plot=not args.no_plot)
+                          plot=not args.no_plot,
+                          options=replay_options(args.latency, args.fixed_latency, args.added_delay))
     print(format_summary(summary))
     print(f"outputs in {args.out}")
     return 0

@@ -35,6 +35,14 @@ class Dataset:
         """Maps LiDAR points into the IMU (body) frame; identity when unknown."""
         return farlio.SE3()
 
+    def gravity_m_s2(self) -> float:
+        """Local gravity; 9.81 unless the recording says otherwise."""
+        return 9.81
+
+    def groundtruth(self) -> Path | None:
+        """A TUM file of true body poses (any rate), when the recording has one."""
+        return None
+
     def groundtruth_scans(self) -> farlio.Trajectory | None:
         """True body poses at the scan end stamps, when the recording has them."""
         return None

@@ -49,6 +49,13 @@ class SequenceFolder(Dataset):
     def T_imu_lidar(self) -> farlio.SE3:
         return self._reader.calibration().T_imu_lidar
 
+    def gravity_m_s2(self) -> float:
+        return self._reader.calibration().gravity_m_s2
+
+    def groundtruth(self) -> Path | None:
+        p = self.path / "groundtruth.tum"
+        return p if p.exists() else None
+
     def groundtruth_scans(self) -> farlio.Trajectory | None:
         return self._reader.groundtruth_scans()
 
