@@ -155,6 +155,8 @@ void bind_pipeline(nb::module_& m) {
           },
           "[(stamp_ns, body pose)] of the 10 ms odometry output since the last call.")
       .def_prop_ro("inertial", [](const PyOdometry& o) { return o.odometry.inertial(); })
+      .def_prop_ro("effective_config", [](const PyOdometry& o) { return o.odometry.scan_pipeline().config(); },
+                   "The parameters in use (the voxel size is fixed at the first scan when auto).")
       .def_prop_ro("fusion_stats", [](const PyOdometry& o) { return o.odometry.fusion_stats(); })
       .def_prop_ro("initial_body_pose", [](const PyOdometry& o) { return o.odometry.initial_body_pose(); })
       .def(

@@ -16,7 +16,13 @@ struct PreprocessConfig {
 
 /// The voxel hash map (cuVoxelMap): the adaptive local submap and the per-scan frame map.
 struct VoxelMapConfig {
-  double voxel_size_m = 4.0;           ///< v: edge of a voxel cube (paper: 4 m)
+  double voxel_size_m = 4.0;           ///< v: edge of a voxel cube (paper: 4 m); the upper bound when auto
+  /// Scale the voxel to the scene at the first scan: v = clamp(p90 range / auto_range_ratio,
+  /// auto_min_voxel_size_m, voxel_size_m). Vehicles outdoors keep the paper's 4 m; rooms and
+  /// corridors get a finer map (a 4 m voxel spans a whole room).
+  bool auto_voxel_size = true;
+  double auto_range_ratio = 6.0;
+  double auto_min_voxel_size_m = 1.0;
   int max_points_per_voxel = 40;       ///< N_max (paper: 40)
   /// Minimum distance between points of a voxel; 0: sqrt(v^2 / N_max) (~0.63 m by default).
   double point_spacing_m = 0.0;

@@ -32,7 +32,7 @@ double point_spacing_m(const VoxelMapConfig& config) {
 
 VoxelMap::VoxelMap(const VoxelMapConfig& config, exec::CpuExecutor& executor)
     : config_(config),
-      executor_(executor),
+      executor_(&executor),
       spacing_m_(static_cast<float>(point_spacing_m(config))) {
   if (config.voxel_size_m <= 0 || config.max_points_per_voxel <= 0 || config.covariance_neighbors <= 0 ||
       config.covariance_neighbors > kMaxNeighbors) {
@@ -112,7 +112,7 @@ InsertStats VoxelMap::insert(const std::vector<Eigen::Vector3f>& points, const E
 
   // 1. group candidates by voxel, in input order inside a voxel
   std::vector<std::pair<std::uint64_t, std::int32_t>> keyed(points.size());
-  executor_.for_each(points.size(), [&](std::size_t i) {
+  executor_->for_each(points.size(), [&](std::size_t i) {
     const Eigen::Vector3f& p = points[i];
     std::uint64_t key = kEmptyKey;
     if (p.allFinite()) {
@@ -121,7 +121,7 @@ InsertStats VoxelMap::insert(const std::vector<Eigen::Vector3f>& points, const E
     }
     keyed[i] = {key, static_cast<std::int32_t>(i)};
   });
-  executor_.run([&] { tbb::parallel_sort(keyed.begin(), keyed.end()); });
+  executor_->run([&] { tbb::parallel_sort(keyed.begin(), keyed.end()); });
   while (!keyed.empty() && keyed.back().first == kEmptyKey) {
     keyed.pop_back();
     ++stats.out_of_range;
@@ -137,7 +137,7 @@ InsertStats VoxelMap::insert(const std::vector<Eigen::Vector3f>& points, const E
   std::vector<std::int32_t> group_voxel(groups);
   {
     const MapView v = view();
-    executor_.for_each(groups, [&](std::size_t g) {
+    executor_->for_each(groups, [&](std::size_t g) {
       const std::uint64_t key = keyed[group_start[g]].first;
       group_voxel[g] = table_find(v, key, spatial_hash(unpack_key(key)));
     });
@@ -167,7 +167,7 @@ InsertStats VoxelMap::insert(const std::vector<Eigen::Vector3f>& points, const E
   const int n_max = config_.max_points_per_voxel;
   std::vector<std::int32_t> first_new(groups);
   std::vector<GroupStats> gstats(groups);
-  executor_.for_each(groups, [&](std::size_t g) {
+  executor_->for_each(groups, [&](std::size_t g) {
     const auto v = static_cast<std::size_t>(group_voxel[g]);
     const std::size_t base = v * static_cast<std::size_t>(n_max);
     std::int32_t count = voxel_counts_[v];
@@ -217,7 +217,7 @@ void VoxelMap::compute_covariances(const std::vector<std::int32_t>& voxels, cons
   const MapView v = view();
   const int k = config_.covariance_neighbors;
   const auto eps = static_cast<float>(config_.covariance_epsilon);
-  executor_.for_each(voxels.size(), [&](std::size_t i) {
+  executor_->for_each(voxels.size(), [&](std::size_t i) {
     const std::int32_t vox = voxels[i];
     const std::int32_t count = v.voxel_counts[vox];
     std::int64_t idx[kMaxNeighbors];

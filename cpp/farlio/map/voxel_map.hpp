@@ -90,7 +90,7 @@ class VoxelMap {
   void compute_covariances(const std::vector<std::int32_t>& voxels, const std::vector<std::int32_t>& first_point);
 
   VoxelMapConfig config_;
-  exec::CpuExecutor& executor_;
+  exec::CpuExecutor* executor_;  // not owned (a pointer keeps the map movable)
   float spacing_m_;
   // hash table
   std::vector<std::uint64_t> slot_keys_;

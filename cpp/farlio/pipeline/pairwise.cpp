@@ -10,7 +10,9 @@ namespace farlio::pipeline {
 
 registration::RegistrationResult register_pair(const std::vector<Eigen::Vector3f>& source,
                                                const std::vector<Eigen::Vector3f>& target, const SE3& initial_guess,
-                                               const Config& config) {
+                                               const Config& requested) {
+  Config config = requested;
+  config.map.voxel_size_m = scene_voxel_size_m(target, config.map);
   exec::CpuExecutor executor(config.num_threads);
   map::VoxelMap target_map(config.map, executor);
   target_map.insert(target, Eigen::Vector3f::Zero(), map::PointLimit::constant(config.map.max_points_per_voxel));

@@ -2,6 +2,9 @@
 
 #include <tbb/parallel_sort.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include "farlio/map/voxel_key.hpp"
 
 namespace farlio::pipeline {
@@ -35,6 +38,22 @@ std::vector<std::int32_t> voxel_downsample(const std::vector<Eigen::Vector3f>& p
     if (i == 0 || keyed[i].first != keyed[i - 1].first) kept.push_back(indices[static_cast<std::size_t>(keyed[i].second)]);
   }
   return kept;
+}
+
+double scene_voxel_size_m(const std::vector<Eigen::Vector3f>& points, const VoxelMapConfig& config) {
+  constexpr std::size_t kStride = 16;      // a subsample is enough for a percentile
+  constexpr double kPercentile = 0.9;
+  if (!config.auto_voxel_size) return config.voxel_size_m;
+  std::vector<float> ranges;
+  for (std::size_t i = 0; i < points.size(); i += kStride) {
+    const float r = points[i].norm();
+    if (std::isfinite(r)) ranges.push_back(r);
+  }
+  if (ranges.empty()) return config.voxel_size_m;
+  const auto nth = ranges.begin() + static_cast<std::ptrdiff_t>(kPercentile * static_cast<double>(ranges.size() - 1));
+  std::nth_element(ranges.begin(), nth, ranges.end());
+  return std::clamp(static_cast<double>(*nth) / config.auto_range_ratio, config.auto_min_voxel_size_m,
+                    config.voxel_size_m);
 }
 
 }  // namespace farlio::pipeline

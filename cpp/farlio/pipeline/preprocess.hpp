@@ -17,4 +17,9 @@ std::vector<std::int32_t> voxel_downsample(const std::vector<Eigen::Vector3f>& p
                                            const std::vector<std::int32_t>& indices, float cell_m,
                                            exec::CpuExecutor& executor);
 
+/// The voxel size for a scene whose first scan is `points` (sensor frame): see
+/// VoxelMapConfig::auto_voxel_size. Returns config.voxel_size_m when auto is off or the scan
+/// is empty.
+double scene_voxel_size_m(const std::vector<Eigen::Vector3f>& points, const VoxelMapConfig& config);
+
 }  // namespace farlio::pipeline

@@ -57,6 +57,18 @@ FrameResult ScanPipeline::process(const Scan& scan, const std::optional<SE3>& in
   out.stamp_ns = scan.end_stamp_ns;
   out.input_points = scan.size();
 
+  // 0. the first scan with points fixes the map's scale
+  if (!scale_fixed_ && !scan.empty()) {
+    scale_fixed_ = true;
+    const double voxel = scene_voxel_size_m(scan.points, config_.map);
+    if (voxel != config_.map.voxel_size_m) {
+      config_.map.voxel_size_m = voxel;
+      map_ = map::VoxelMap(config_.map, executor_);
+      frame_map_ = map::VoxelMap(frame_map_config(config_), executor_);
+    }
+    config_.map.auto_voxel_size = false;  // the effective config states the size used
+  }
+
   // 1. preprocess: crop, undistort into the scan-end frame, downsample to the map spacing
   auto t0 = Clock::now();
   const std::vector<std::int32_t> cropped = crop_by_range(scan.points, config_.preprocess);

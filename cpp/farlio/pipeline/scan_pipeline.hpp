@@ -58,6 +58,7 @@ class ScanPipeline {
                       const std::optional<deskew::ScanMotion>& motion = std::nullopt);
 
   [[nodiscard]] const map::VoxelMap& local_map() const { return map_; }
+  /// The effective parameters (the voxel size is fixed at the first scan when auto).
   [[nodiscard]] const Config& config() const { return config_; }
   [[nodiscard]] std::size_t frames() const { return frames_; }
   [[nodiscard]] exec::CpuExecutor& executor() { return executor_; }
@@ -76,6 +77,7 @@ class ScanPipeline {
   SE3 last_pose_, prev_pose_;
   std::int64_t last_stamp_ns_ = 0, prev_stamp_ns_ = 0;
   std::size_t frames_ = 0;
+  bool scale_fixed_ = false;
 };
 
 }  // namespace farlio::pipeline
