@@ -41,6 +41,7 @@ TEST_P(ScanPair, RegistersFromPerturbedStarts) {
   const PairCase c = GetParam();
   Config cfg;
   cfg.map.voxel_size_m = c.voxel_size_m;
+  cfg.map.auto_voxel_size = false;  // this test is about these voxel sizes
   std::vector<SE3> results;
   for (const auto& [offset_m, angle_deg] : {std::pair{0.0, 0.0}, {0.5, 0.0}, {0.0, 5.0}, {0.5, 5.0}, {0.5, -5.0}}) {
     Vec6d d;
