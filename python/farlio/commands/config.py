@@ -1,0 +1,35 @@
+"""`farlio config`: every parameter with its default and meaning, as a YAML file to edit."""
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from farlio import _core
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--out", type=Path, default=None, help="write the YAML here instead of printing it")
+
+
+def render() -> str:
+    lines = ["# farlio parameters: dotted names, defaults, units in the names. Pass with --config FILE",
+             "# or one at a time with --set name=value."]
+    section = None
+    for name, default, doc in _core.Config.fields():
+        head, _, leaf = name.rpartition(".")
+        if head != section:
+            section = head
+            lines.append(f"{head}:" if head else "")
+        indent = "  " if head else ""
+        lines.append(f"{indent}{leaf or name}: {default}  # {doc}")
+    return "\n".join(lines) + "\n"
+
+
+def run(args: argparse.Namespace) -> int:
+    text = render()
+    if args.out:
+        args.out.parent.mkdir(parents=True, exist_ok=True)
+        args.out.write_text(text)
+    else:
+        print(text, end="")
+    return 0
