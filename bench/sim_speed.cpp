@@ -4,6 +4,7 @@
 #include <tbb/info.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -12,7 +13,7 @@
 
 namespace {
 constexpr std::size_t kDefaultScans = 10;
-constexpr std::size_t kFirstScan = 20;  // skip the first scans (urban and handheld start at rest)
+constexpr double kFirstScan_s = 3.0;  // skip the first scans: every profile starts at rest for 2 s
 
 struct Timing {
   double mean_ms = 0.0, max_ms = 0.0;
@@ -21,7 +22,8 @@ struct Timing {
 
 Timing time_scans(const farlio::sim::SequenceGenerator& gen, std::size_t count) {
   Timing t;
-  for (std::size_t i = kFirstScan; i < kFirstScan + count; ++i) {
+  const auto first = static_cast<std::size_t>(std::llround(kFirstScan_s * gen.lidar_rate_hz()));
+  for (std::size_t i = first; i < first + count; ++i) {
     const auto start = std::chrono::steady_clock::now();
     const farlio::Scan scan = gen.scan(i);
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

@@ -44,11 +44,13 @@ Integrated integrate(const std::vector<ImuSample>& imu, std::size_t k0, std::siz
   return x;
 }
 
-/// Times worth testing: the start, the sharpest turn and the hardest acceleration.
+/// Times worth testing: the start, the first movement, the sharpest turn and the hardest
+/// acceleration.
 std::vector<double> interesting_times(const SequenceGenerator& gen, double horizon_end_s) {
-  double t_turn = 0.0, best_rate = -1.0, t_accel = 0.0, best_accel = -1.0;
+  double t_turn = 0.0, best_rate = -1.0, t_accel = 0.0, best_accel = -1.0, t_move = -1.0;
   for (double t = 0.0; t < horizon_end_s; t += 0.05) {
     const BodyState s = gen.state(gen.config().start_stamp_ns + std::llround(t * 1e9));
+    if (t_move < 0.0 && s.velocity_world_m_s.norm() > 1e-3) t_move = std::max(0.0, t - 0.05);
     if (s.angular_velocity_body_rad_s.norm() > best_rate) {
       best_rate = s.angular_velocity_body_rad_s.norm();
       t_turn = t;
@@ -58,17 +60,20 @@ std::vector<double> interesting_times(const SequenceGenerator& gen, double horiz
       t_accel = t;
     }
   }
-  return {0.0, std::max(0.0, t_turn - 0.5), std::max(0.0, t_accel - 0.5), 0.37 * horizon_end_s};
+  return {0.0, std::max(0.0, t_move), std::max(0.0, t_turn - 0.5), std::max(0.0, t_accel - 0.5), 0.37 * horizon_end_s};
 }
 
-void check_profile(Profile profile, double search_s) {
+/// extra_times_s: more start times to check, on top of interesting_times().
+void check_profile(Profile profile, double search_s, const std::vector<double>& extra_times_s = {}) {
   SimConfig cfg = default_config(profile);
   cfg.noise_free = true;
   cfg.duration_s = search_s + 2.0 * kHorizon_s;
   const SequenceGenerator gen(cfg);
   const std::vector<ImuSample> imu = gen.imu();
   const auto n = static_cast<std::size_t>(std::llround(kHorizon_s * gen.imu_rate_hz()));
-  for (const double t0 : interesting_times(gen, search_s)) {
+  std::vector<double> times = interesting_times(gen, search_s);
+  times.insert(times.end(), extra_times_s.begin(), extra_times_s.end());
+  for (const double t0 : times) {
     const auto k0 = static_cast<std::size_t>(std::llround(t0 * gen.imu_rate_hz()));
     ASSERT_LT(k0 + n, imu.size());
     const BodyState start = gen.state(imu[k0].stamp_ns);
@@ -84,20 +89,38 @@ void check_profile(Profile profile, double search_s) {
 }
 }  // namespace
 
-TEST(SimImu, RacetrackNoiseFreeIntegratesToTruth) { check_profile(Profile::Racetrack, 40.0); }
+TEST(SimImu, RacetrackNoiseFreeIntegratesToTruth) {
+  // The standing start: at rest for 2 s, then accelerating down the start straight for ~9 s.
+  // Horizons starting at 1.5 s (rest into launch) and 2.5, 5 and 8 s (hard acceleration).
+  const std::vector<double> launch_s = {2.5, 5.0, 8.0};
+  const SequenceGenerator gen(default_config(Profile::Racetrack));
+  for (const double t : launch_s) {  // these horizons lie inside the acceleration phase
+    const BodyState s = gen.state(gen.config().start_stamp_ns + std::llround((t + 0.5 * kHorizon_s) * 1e9));
+    const double v = s.velocity_world_m_s.norm();
+    ASSERT_GT(v, 0.1) << t;
+    EXPECT_GT(s.acceleration_world_m_s2.dot(s.velocity_world_m_s) / v, 1.0) << "accelerating mid-horizon at " << t;
+  }
+  std::vector<double> times = launch_s;
+  times.push_back(1.5);  // from rest into the launch
+  check_profile(Profile::Racetrack, 40.0, times);
+}
+
 TEST(SimImu, UrbanNoiseFreeIntegratesToTruth) { check_profile(Profile::Urban, 60.0); }
 TEST(SimImu, HandheldNoiseFreeIntegratesToTruth) { check_profile(Profile::Handheld, 40.0); }
 
 TEST(SimImu, AtRestReadsGravityUp) {
-  SimConfig cfg = default_config(Profile::Urban);  // urban starts standing still
-  cfg.noise_free = true;
-  cfg.duration_s = 1.0;
-  const SequenceGenerator gen(cfg);
-  const ImuSample s = gen.imu().front();
-  const Mat3d R = gen.state(s.stamp_ns).pose_world_body.rotation();
-  EXPECT_NEAR((R * s.accel_m_s2).z(), gen.gravity_m_s2(), 1e-9);
-  EXPECT_NEAR((R * s.accel_m_s2).head<2>().norm(), 0.0, 1e-9);
-  EXPECT_LT(s.gyro_rad_s.norm(), 1e-12);
+  for (const Profile p : {Profile::Urban, Profile::Racetrack}) {  // both start standing still
+    SimConfig cfg = default_config(p);
+    cfg.noise_free = true;
+    cfg.duration_s = 1.0;
+    const SequenceGenerator gen(cfg);
+    for (const ImuSample& s : {gen.imu().front(), gen.imu().back()}) {
+      const Mat3d R = gen.state(s.stamp_ns).pose_world_body.rotation();
+      EXPECT_NEAR((R * s.accel_m_s2).z(), gen.gravity_m_s2(), 1e-9) << profile_name(p);
+      EXPECT_NEAR((R * s.accel_m_s2).head<2>().norm(), 0.0, 1e-9) << profile_name(p);
+      EXPECT_LT(s.gyro_rad_s.norm(), 1e-12) << profile_name(p);
+    }
+  }
 }
 
 TEST(SimImu, NoiseMatchesConfiguredStatistics) {

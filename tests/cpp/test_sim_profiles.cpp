@@ -17,9 +17,9 @@ struct Extremes {
   double z_min_m = 1e9, z_max_m = -1e9, standstill_s = 0.0;
 };
 
-Extremes sample(const SequenceGenerator& gen, double duration_s) {
+Extremes sample(const SequenceGenerator& gen, double duration_s, double from_s = 0.0) {
   Extremes e;
-  for (double t = 0.0; t <= duration_s; t += 1.0 / kSampleRate_hz) {
+  for (double t = from_s; t <= duration_s; t += 1.0 / kSampleRate_hz) {
     const BodyState s = gen.state(gen.config().start_stamp_ns + std::llround(t * 1e9));
     const double v = s.velocity_world_m_s.norm();
     e.max_speed_m_s = std::max(e.max_speed_m_s, v);
@@ -35,22 +35,61 @@ Extremes sample(const SequenceGenerator& gen, double duration_s) {
 }  // namespace
 
 TEST(SimProfiles, RacetrackSpeedAndCornering) {
-  SimConfig cfg = default_config(Profile::Racetrack);
-  cfg.duration_s = 120.0;  // more than a lap
+  // Over the default duration (standing start, then one full lap): top speed and cornering.
+  const SimConfig cfg = default_config(Profile::Racetrack);
   const SequenceGenerator gen(cfg);
   const Extremes e = sample(gen, cfg.duration_s);
   EXPECT_GE(e.max_speed_m_s, 60.0);
   EXPECT_LE(e.max_speed_m_s, 70.0 + 1e-3);
   EXPECT_GE(e.max_lateral_m_s2, 15.0);
   EXPECT_LE(e.max_lateral_m_s2, 27.0);
-  EXPECT_GT(e.min_speed_m_s, 20.0) << "a race car never stops";
   const double lap_m = std::stod(gen.description().at("lap_length_m"));
   EXPECT_GT(lap_m, 3000.0);
-  // The circuit is closed: one lap later the car is back where it was.
+  const double first_lap_s = std::stod(gen.description().at("first_lap_time_s"));
+  EXPECT_LE(first_lap_s, cfg.duration_s) << "the default duration covers the whole first lap";
+  // Once under way, a race car never slows down much (later laps too).
+  const Extremes racing = sample(gen, 2.0 * first_lap_s, 12.0);
+  EXPECT_GT(racing.min_speed_m_s, 20.0) << "a race car never stops";
+  EXPECT_LE(racing.max_speed_m_s, 70.0 + 1e-3);
+  EXPECT_LE(racing.max_lateral_m_s2, 27.0);
+}
+
+TEST(SimProfiles, RacetrackStandingStart) {
+  const SequenceGenerator gen(default_config(Profile::Racetrack));
+  const auto state_at = [&](double t) { return gen.state(gen.config().start_stamp_ns + std::llround(t * 1e9)); };
+  // At rest on the grid for 2 s: an odometry can start with a zero velocity.
+  const Extremes rest = sample(gen, 2.0);
+  EXPECT_LT(rest.max_speed_m_s, 1e-6);
+  EXPECT_LT(rest.max_rate_rad_s, 1e-9);
+  // Then it accelerates down the start straight: speed grows monotonically to near top speed,
+  // with a longitudinal acceleration within the limit.
+  double prev_v = 0.0, max_long = 0.0;
+  for (double t = 2.05; t <= 10.0; t += 0.05) {
+    const BodyState s = state_at(t);
+    const double v = s.velocity_world_m_s.norm();
+    EXPECT_GT(v, prev_v) << t;
+    prev_v = v;
+    max_long = std::max(max_long, s.acceleration_world_m_s2.dot(s.velocity_world_m_s) / v);
+    EXPECT_LT(s.angular_velocity_body_rad_s.norm(), 1e-9) << "still on the straight at " << t;
+  }
+  EXPECT_GT(prev_v, 60.0);
+  EXPECT_GT(max_long, 10.0);
+  EXPECT_LE(max_long, 15.0 + 1e-6);
+  // The circuit is closed: the first lap ends where the car started, and so does every later
+  // (steady) lap.
+  const double first_lap_s = std::stod(gen.description().at("first_lap_time_s"));
   const double lap_s = std::stod(gen.description().at("lap_time_s"));
-  const auto p0 = gen.state(cfg.start_stamp_ns + std::llround(1e9)).pose_world_body;
-  const auto p1 = gen.state(cfg.start_stamp_ns + std::llround((1.0 + lap_s) * 1e9)).pose_world_body;
-  EXPECT_LT((p0.translation() - p1.translation()).norm(), 1e-3);
+  EXPECT_GT(first_lap_s, lap_s + 2.0) << "rest and acceleration cost time";
+  const Eigen::Vector3d p0 = state_at(0.0).pose_world_body.translation();
+  EXPECT_LT((p0 - state_at(first_lap_s).pose_world_body.translation()).norm(), 1e-3);
+  const auto p1 = state_at(first_lap_s + 1.0).pose_world_body;
+  const auto p2 = state_at(first_lap_s + 1.0 + lap_s).pose_world_body;
+  EXPECT_LT((p1.translation() - p2.translation()).norm(), 1e-3);
+  // Crossing from the first lap into the steady laps is smooth (same speed and acceleration).
+  const BodyState a = state_at(first_lap_s - 1e-4), b = state_at(first_lap_s + 1e-4);
+  EXPECT_LT((a.velocity_world_m_s - b.velocity_world_m_s).norm(), 1e-3);
+  EXPECT_LT((a.acceleration_world_m_s2 - b.acceleration_world_m_s2).norm(), 1e-3);
+  EXPECT_NEAR(a.velocity_world_m_s.norm(), 70.0, 1e-6);
 }
 
 TEST(SimProfiles, UrbanHasStopsTurnsAndSlopes) {

@@ -12,10 +12,10 @@ namespace {
 constexpr double kSurfaceTolerance_m = 2e-3;  // float32 point coordinates at up to ~200 m
 constexpr std::size_t kPointStride = 53;      // check every 53rd point
 
-/// A scan index at which the body moves (urban and handheld start standing still).
+/// A scan index at which the body moves (every profile starts standing still).
 std::size_t moving_scan(Profile p) {
   switch (p) {
-    case Profile::Racetrack: return 7;
+    case Profile::Racetrack: return 200;  // 10 s: near top speed at the end of the standing start
     case Profile::Urban: return 100;
     case Profile::Handheld: return 40;
   }

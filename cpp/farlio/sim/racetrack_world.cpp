@@ -1,4 +1,5 @@
-// The racetrack profile: a ~4 km closed circuit driven at up to 70 m/s, lined with concrete
+// The racetrack profile: a ~4 km closed circuit driven at up to 70 m/s from a standing start
+// (at rest for 2 s, then accelerating down the start straight), lined with concrete
 // barriers, catch fences with gaps, posts, marshal boards, grandstands and a pit building;
 // three 120-degree raster LiDARs (front, left, right) merged into one frame.
 #include <cmath>
@@ -17,6 +18,7 @@ constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr double kMaxSpeed_m_s = 70.0;
 constexpr double kMaxLateralAccel_m_s2 = 24.0;
 constexpr double kMaxLongitudinalAccel_m_s2 = 15.0;
+constexpr double kInitialRest_s = 2.0;  // standing start: a LiDAR-inertial odometry cannot know an initial speed
 constexpr double kBodyHeight_m = 0.5;
 // Trackside (lateral offsets from the centre line).
 constexpr double kBarrierOffset_m = 7.0, kBarrierHeight_m = 1.0, kBarrierThickness_m = 0.6, kBarrierStep_m = 5.0;
@@ -132,7 +134,7 @@ World build_racetrack_world() {
   // Radii in travel order: corners at vertices 1, 2, ..., 9, 0.
   const std::vector<double> radii = {120, 250, 60, 45, 45, 80, 150, 90, 70, 100};
   Path path = Path::from_polyline(vertices, radii, true);
-  SpeedPlan plan(path, {kMaxSpeed_m_s, kMaxLateralAccel_m_s2, kMaxLongitudinalAccel_m_s2, 0.0}, {});
+  SpeedPlan plan(path, {kMaxSpeed_m_s, kMaxLateralAccel_m_s2, kMaxLongitudinalAccel_m_s2, kInitialRest_s, true}, {});
 
   World w;
   Rng rng(kLayoutSeed);
@@ -145,7 +147,9 @@ World build_racetrack_world() {
   w.scene.build_index(kGridCell_m);
 
   w.facts["lap_length_m"] = std::to_string(path.length_m());
-  w.facts["lap_time_s"] = std::to_string(plan.plan_duration_s());
+  w.facts["lap_time_s"] = std::to_string(plan.lap_time_s());             // a steady (flying) lap
+  w.facts["first_lap_time_s"] = std::to_string(plan.plan_duration_s());  // rest + standing start + lap
+  w.facts["initial_rest_s"] = std::to_string(kInitialRest_s);
   w.facts["lidar"] = "3 raster LiDARs (front, left, right), 120 deg x 128 channels x 570 columns each";
   w.motion = std::make_shared<VehicleMotion>(std::move(path), std::move(plan), SmoothCurve({0.0}, {0.0}), kBodyHeight_m);
   w.T_imu_lidar = mount_pose({0.6, 0.0, 0.5}, 0.01, 0.02, -0.005);

@@ -68,14 +68,11 @@ class Planner {
   double a_lon_;
   SmoothCurve curve_;
 };
-}  // namespace
 
-SpeedPlan::SpeedPlan(const Path& path, const SpeedLimits& limits, const std::vector<Stop>& stops) {
-  periodic_ = path.closed();
-  lap_length_m_ = path.length_m();
-  const double v0 = periodic_ ? limits.max_speed_m_s : 0.0;
-  Planner plan(v0, limits.max_longitudinal_accel_m_s2);
-  if (!periodic_ && limits.initial_rest_s > 0.0) plan.hold(limits.initial_rest_s);
+/// Drives every corner of the path once from the planner's state (at s = 0), recording the
+/// stops' time intervals.
+void drive_corners(Planner& plan, const Path& path, const SpeedLimits& limits, const std::vector<Stop>& stops,
+                   std::vector<std::pair<double, double>>& stop_intervals_s) {
   const auto& corners = path.corners();
   for (std::size_t c = 0; c < corners.size(); ++c) {
     const double v_corner =
@@ -86,30 +83,61 @@ SpeedPlan::SpeedPlan(const Path& path, const SpeedLimits& limits, const std::vec
     if (stop != stops.end()) {
       const double begin = plan.t_;
       plan.hold(stop->hold_s);
-      stops_s_.emplace_back(begin, plan.t_);
+      stop_intervals_s.emplace_back(begin, plan.t_);
     }
     if (plan.v_ < v_corner) plan.ramp_to(v_corner);
     if (plan.s_ < corners[c].s_end_m) plan.cruise_to(corners[c].s_end_m);
   }
+}
+
+/// Ends a lap of a closed path exactly at the start line at speed v_end.
+void finish_lap(Planner& plan, double lap_length_m, double v_end, double v_max) {
+  plan.arrive(lap_length_m, v_end, v_max, "the lap end");
+  if (std::abs(plan.s_ - lap_length_m) > kRoomTolerance_m || plan.v_ != v_end)
+    throw std::invalid_argument("SpeedPlan: lap does not end at its start speed");
+}
+}  // namespace
+
+SpeedPlan::SpeedPlan(const Path& path, const SpeedLimits& limits, const std::vector<Stop>& stops) {
+  periodic_ = path.closed();
+  lap_length_m_ = path.length_m();
+  const double a_lon = limits.max_longitudinal_accel_m_s2;
+  // A steady lap starts and ends on a plateau at full speed.
+  const double v_lap = limits.max_speed_m_s;
+  std::vector<std::pair<double, double>> lap_stops_s;
   if (periodic_) {
-    plan.arrive(lap_length_m_, v0, limits.max_speed_m_s, "the lap end");
-    if (std::abs(plan.s_ - lap_length_m_) > kRoomTolerance_m || plan.v_ != v0)
-      throw std::invalid_argument("SpeedPlan: lap does not end at its start speed");
+    Planner lap(v_lap, a_lon);
+    drive_corners(lap, path, limits, stops, lap_stops_s);
+    finish_lap(lap, lap_length_m_, v_lap, limits.max_speed_m_s);
+    lap_time_s_ = lap.t_;
+    lap_ = std::move(lap.curve_);
+  }
+  if (periodic_ && !limits.standing_start) {  // flying start: the first lap is a steady one
+    first_ = lap_;
+    plan_duration_s_ = lap_time_s_;
+    stops_s_ = std::move(lap_stops_s);
+    return;
+  }
+  Planner plan(0.0, a_lon);
+  if (limits.initial_rest_s > 0.0) plan.hold(limits.initial_rest_s);
+  drive_corners(plan, path, limits, stops, stops_s_);
+  if (periodic_) {
+    finish_lap(plan, lap_length_m_, v_lap, limits.max_speed_m_s);  // hands over to the steady lap
   } else {
     plan.ramp_to(limits.max_speed_m_s);
     if (plan.s_ < lap_length_m_) plan.cruise_to(lap_length_m_);
   }
   plan_duration_s_ = plan.t_;
-  speed_ = std::move(plan.curve_);
+  first_ = std::move(plan.curve_);
 }
 
 Progress SpeedPlan::at(double t_s) const {
-  double laps = 0.0;
-  if (periodic_) {
-    laps = std::floor(t_s / plan_duration_s_);
-    t_s -= laps * plan_duration_s_;
-  }
-  return {laps * lap_length_m_ + speed_.integral(t_s), speed_.value(t_s), speed_.derivative(t_s)};
+  if (!periodic_ || t_s < plan_duration_s_) return {first_.integral(t_s), first_.value(t_s), first_.derivative(t_s)};
+  // After the first lap: steady laps, each starting at the start line.
+  t_s -= plan_duration_s_;
+  const double laps = std::floor(t_s / lap_time_s_);
+  t_s -= laps * lap_time_s_;
+  return {(laps + 1.0) * lap_length_m_ + lap_.integral(t_s), lap_.value(t_s), lap_.derivative(t_s)};
 }
 
 }  // namespace farlio::sim
