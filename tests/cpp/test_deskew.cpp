@@ -50,3 +50,24 @@ TEST(Deskew, ConstantTwistMovesPointsIntoTheEndFrame) {
   const Eigen::Vector3d at_start = (T_end * SE3::exp(-duration * twist)).inverse() * w;
   EXPECT_GT((at_start - T_end.inverse() * w).norm(), 1.0);
 }
+
+#include "farlio/deskew/motion_fit.hpp"
+
+TEST(Deskew, RegressionRecoversAConstantTwist) {
+  // Poses of a sensor moving with a constant body twist, sampled over a scan: the linear fit
+  // of log(T_end^-1 T(tau)) gives offset = -D w and rate = w.
+  Vec6d twist;
+  twist << 30.0, -1.0, 0.2, 0.05, 0.1, 1.5;
+  const double duration = 0.1;
+  const SE3 T_end = SE3::exp((Vec6d() << 10, 2, 1, 0.1, 0, 0.3).finished());
+  std::vector<std::pair<double, SE3>> samples;
+  for (int i = 0; i <= 10; ++i) {
+    const double tau = duration * i / 10.0;
+    samples.emplace_back(tau, T_end * SE3::exp((tau - duration) * twist));
+  }
+  const ScanMotion m = fit_scan_motion(samples, T_end);
+  const ScanMotion expected = ScanMotion::constant_twist(twist.cast<float>(), static_cast<float>(duration));
+  EXPECT_LT((m.rate - expected.rate).norm(), 1e-3f);
+  EXPECT_LT((m.offset - expected.offset).norm(), 1e-4f);
+  EXPECT_TRUE(fit_scan_motion({samples.front()}, T_end).is_identity());  // one sample: no fit
+}

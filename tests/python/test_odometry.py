@@ -13,31 +13,72 @@ import farlio
 from farlio import _core
 from farlio.cli import main as cli
 from farlio.datasets import open_dataset
-from farlio.runner import run_dataset
+from farlio.config import load_config
+from farlio.runner import replay_options, run_dataset
 from farlio.simulation import generate
 
-# (profile, seconds, APE RMSE bound m, KITTI-style RPE bound %). Measured (seed 1):
-# urban 10 s: APE 0.012 m, RPE 0.06 %; handheld 15 s: APE ~0.06 m, RPE ~1.6 % (LiDAR-only
-# suffers from the 3 rad/s head turns under a constant-velocity model; the IMU fixes that).
-CASES = [("urban", 10.0, 0.05, 0.3), ("handheld", 15.0, 0.25, 4.0)]
+# (profile, seconds, mode, scan-pose APE RMSE bound m, KITTI-style RPE bound %, 100 Hz odometry
+# APE bound m). Measured with a fixed 20 ms latency (seed 1), bounds ~3x above:
+#   urban 10 s     LIO: APE 0.012 m, RPE 0.09 %, odometry APE 0.015 m; LiDAR-only: 0.015 m, 0.11 %
+#   handheld 25 s  LIO: APE 0.008 m, RPE 0.17 %, odometry APE 0.015 m; LiDAR-only: 0.100 m, 2.0 %
+# (LiDAR-only suffers from the 3 rad/s head turns under its constant-velocity model.)
+CASES = [
+    ("urban", 10.0, "lio", 0.04, 0.3, 0.05),
+    ("urban", 10.0, "lidar", 0.05, 0.4, None),
+    ("handheld", 25.0, "lio", 0.03, 0.6, 0.05),
+    ("handheld", 25.0, "lidar", 0.3, 5.0, None),
+]
 
 
-@pytest.mark.parametrize("profile,duration,ape_bound,rpe_bound", CASES)
-def test_lidar_only_odometry_on_generated_sequences(tmp_path, profile, duration, ape_bound, rpe_bound):
-    seq = tmp_path / profile
-    generate(profile, seq, duration_s=duration)
-    summary = run_dataset(open_dataset(seq), tmp_path / "out", progress=False, plot=False)
+@pytest.fixture(scope="module")
+def sequences(tmp_path_factory):
+    root = tmp_path_factory.mktemp("seq")
+    made = {}
+
+    def get(profile: str, duration: float) -> Path:
+        key = (profile, duration)
+        if key not in made:
+            made[key] = root / f"{profile}_{duration:g}"
+            generate(profile, made[key], duration_s=duration)
+        return made[key]
+
+    return get
+
+
+@pytest.mark.parametrize("profile,duration,mode,ape_bound,rpe_bound,odom_bound", CASES)
+def test_odometry_on_generated_sequences(tmp_path, sequences, profile, duration, mode, ape_bound, rpe_bound,
+                                         odom_bound):
+    seq = sequences(profile, duration)
+    config = load_config(None, [] if mode == "lio" else ["fusion.enabled=false"])
+    summary = run_dataset(open_dataset(seq), tmp_path / "out", config, progress=False, plot=False,
+                          options=replay_options("fixed", 0.02))
     acc = summary["accuracy"]
+    assert summary["mode"] == ("lidar-inertial" if mode == "lio" else "lidar-only")
     assert summary["processed"] == summary["frames"] == len(list((seq / "lidar").iterdir()))
+    assert summary["dropped"] == 0
     assert summary["converged_fraction"] > 0.95
     assert acc["coverage"] == 1.0
     assert acc["ape"]["translation_m"]["rmse"] < ape_bound
+    assert acc["kitti_rpe"]["segment_count"] > 0
     assert acc["kitti_rpe"]["translation_pct"] < rpe_bound
-    # outputs say their frame and are complete
-    for name in ("scans_lidar.tum", "scans_body.tum", "scans_lidar_kitti.txt", "timing.csv", "summary.json",
-                 "config.yaml", "eval_scans/eval.json"):
+    if odom_bound is not None:
+        assert summary["accuracy_odometry"]["ape"]["translation_m"]["rmse"] < odom_bound
+        assert summary["accuracy_odometry"]["coverage"] > 0.95
+    names = ["scans_lidar.tum", "scans_body.tum", "scans_lidar_kitti.txt", "timing.csv", "summary.json",
+             "config.yaml", "eval_scans/eval.json"] + (["odometry_body.tum"] if mode == "lio" else [])
+    for name in names:
         assert (tmp_path / "out" / name).exists(), name
     assert len(_core.io.read_tum(tmp_path / "out" / "scans_body.tum")) == summary["processed"]
+
+
+def test_replay_is_deterministic_with_a_fixed_latency(tmp_path, sequences):
+    seq = sequences("urban", 10.0)
+    outs = []
+    for k in range(2):
+        run_dataset(open_dataset(seq), tmp_path / f"r{k}", None, progress=False, plot=False,
+                    options=replay_options("fixed", 0.03), max_frames=40)
+        outs.append((tmp_path / f"r{k}" / "odometry_body.tum").read_text())
+    assert outs[0] == outs[1] and len(outs[0].splitlines()) > 300
 
 
 def test_run_cli_on_kitti_layout_and_bad_scan(tmp_path, capsys):
