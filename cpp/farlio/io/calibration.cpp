@@ -1,3 +1,4 @@
+#include "farlio/io/file_bytes.hpp"
 #include "farlio/io/calibration.hpp"
 
 #include <yaml-cpp/yaml.h>
@@ -88,11 +89,7 @@ void write_calibration(const std::filesystem::path& path, const Calibration& cal
   text += "gravity: " + format_number(calib.gravity_m_s2) + "\n";
   if (calib.imu_rate_hz > 0) text += "imu:\n  rate_hz: " + format_number(calib.imu_rate_hz) + "\n";
   if (calib.lidar_rate_hz > 0) text += "lidar:\n  rate_hz: " + format_number(calib.lidar_rate_hz) + "\n";
-  std::ofstream out(path, std::ios::trunc);
-  if (!out) throw std::runtime_error(path.string() + ": cannot open for writing");
-  out << text;
-  out.flush();
-  if (!out) throw std::runtime_error(path.string() + ": write error");
+  write_text_file(path, text);
 }
 
 }  // namespace farlio::io

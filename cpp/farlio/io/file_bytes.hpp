@@ -20,4 +20,7 @@ using Bytes = std::vector<unsigned char>;
 /// std::runtime_error naming the file if it cannot be written.
 void write_file_bytes(const std::filesystem::path& path, std::span<const unsigned char> bytes);
 
+/// write_file_bytes for text.
+void write_text_file(const std::filesystem::path& path, const std::string& text);
+
 }  // namespace farlio::io

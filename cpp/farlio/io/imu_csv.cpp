@@ -1,3 +1,4 @@
+#include "farlio/io/file_bytes.hpp"
 #include "farlio/io/imu_csv.hpp"
 
 #include <array>
@@ -112,11 +113,7 @@ void write_imu_csv(const std::filesystem::path& path, const std::vector<ImuSampl
     }
     text += '\n';
   }
-  std::ofstream out(path, std::ios::trunc);
-  if (!out) throw std::runtime_error(path.string() + ": cannot open for writing");
-  out << text;
-  out.flush();
-  if (!out) throw std::runtime_error(path.string() + ": write error");
+  write_text_file(path, text);
 }
 
 }  // namespace farlio::io

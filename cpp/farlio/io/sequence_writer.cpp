@@ -5,6 +5,7 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "farlio/io/file_bytes.hpp"
 #include "farlio/io/imu_csv.hpp"
 #include "farlio/io/sequence.hpp"
 #include "farlio/io/text_number.hpp"
@@ -15,13 +16,6 @@ namespace {
 
 constexpr std::size_t kKittiNameBytes = 32;  // "%06zu.bin" with room for any size_t
 
-void write_text(const std::filesystem::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::trunc);
-  if (!out) throw std::runtime_error(path.string() + ": cannot open for writing");
-  out << text;
-  out.flush();
-  if (!out) throw std::runtime_error(path.string() + ": write error");
-}
 
 }  // namespace
 
@@ -65,7 +59,7 @@ void SequenceWriter::write_kitti_scan(const Scan& scan, std::size_t index) {
 void SequenceWriter::write_kitti_times(const std::vector<std::int64_t>& scan_stamps_ns) {
   std::string text;
   for (auto s : scan_stamps_ns) text += format_seconds_from_ns(s - scan_stamps_ns.front()) + "\n";
-  write_text(dir_ / "times.txt", text);
+  write_text_file(dir_ / "times.txt", text);
 }
 
 void SequenceWriter::write_meta(const std::map<std::string, std::string>& meta) {
@@ -73,7 +67,7 @@ void SequenceWriter::write_meta(const std::map<std::string, std::string>& meta) 
   e << YAML::BeginMap;
   for (const auto& [k, v] : meta) e << YAML::Key << k << YAML::Value << v;
   e << YAML::EndMap;
-  write_text(dir_ / "meta.yaml", std::string(e.c_str()) + "\n");
+  write_text_file(dir_ / "meta.yaml", std::string(e.c_str()) + "\n");
 }
 
 }  // namespace farlio::io

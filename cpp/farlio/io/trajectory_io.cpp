@@ -1,3 +1,4 @@
+#include "farlio/io/file_bytes.hpp"
 #include "farlio/io/trajectory_io.hpp"
 
 #include <array>
@@ -38,13 +39,6 @@ std::ifstream open_for_reading(const std::filesystem::path& path) {
   return in;
 }
 
-void write_text(const std::filesystem::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::trunc);
-  if (!out) throw std::runtime_error(path.string() + ": cannot open for writing");
-  out << text;
-  out.flush();
-  if (!out) throw std::runtime_error(path.string() + ": write error");
-}
 
 /// Calls on_values(line_no, tokens) for every non-blank, non-comment line.
 template <class F>
@@ -92,7 +86,7 @@ Trajectory read_tum(const std::filesystem::path& path) {
 void write_tum(const std::filesystem::path& path, const Trajectory& trajectory) {
   std::string text = kTumHeader;
   for (const auto& p : trajectory) text += tum_line(p.stamp_ns, p.pose);
-  write_text(path, text);
+  write_text_file(path, text);
 }
 
 Trajectory read_kitti(const std::filesystem::path& path, const std::vector<std::int64_t>* stamps_ns) {
@@ -131,7 +125,7 @@ void write_kitti(const std::filesystem::path& path, const Trajectory& trajectory
     }
     text += '\n';
   }
-  write_text(path, text);
+  write_text_file(path, text);
 }
 
 TrajectoryWriter::TrajectoryWriter(const std::filesystem::path& path) : path_(path), out_(path, std::ios::trunc) {

@@ -63,10 +63,26 @@ class SequenceFolder(Dataset):
         return list(self._reader.warnings())
 
 
-class KittiOdometry(Dataset):
+class _FilesWithStamps(Dataset):
+    """One file a scan (self._files) with end stamps (self._stamps, ns)."""
+
+    _files: list[Path]
+    _stamps: list[int]
+
+    def __len__(self) -> int:
+        return len(self._files)
+
+    def scan(self, i: int) -> farlio.Scan:
+        period = self._stamps[i] - self._stamps[i - 1] if i > 0 else DEFAULT_PERIOD_NS
+        return _with_stamps(_core.io.read_point_cloud(self._files[i]), self._stamps[i] - period, self._stamps[i])
+
+    def scan_source(self, i: int) -> str:
+        return str(self._files[i])
+
+
+class KittiOdometry(_FilesWithStamps):
     """A KITTI odometry sequence: velodyne/NNNNNN.bin and times.txt (seconds); no per-point time
-    (KITTI scans are already undistorted). Ground truth is read from groundtruth_kitti.txt or
-    ../../poses/<seq>.txt when present (LiDAR poses, first = identity)."""
+    (KITTI scans are already undistorted)."""
 
     @classmethod
     def matches(cls, path: Path) -> bool:
@@ -87,18 +103,9 @@ class KittiOdometry(Dataset):
         else:
             self._stamps = [(i + 1) * DEFAULT_PERIOD_NS for i in range(len(self._files))]
 
-    def __len__(self) -> int:
-        return len(self._files)
-
-    def scan(self, i: int) -> farlio.Scan:
-        period = self._stamps[i] - self._stamps[i - 1] if i > 0 else DEFAULT_PERIOD_NS
-        return _with_stamps(_core.io.read_point_cloud(self._files[i]), self._stamps[i] - period, self._stamps[i])
-
-    def scan_source(self, i: int) -> str:
-        return str(self._files[i])
 
 
-class PointCloudFolder(Dataset):
+class PointCloudFolder(_FilesWithStamps):
     """A folder of .pcd/.pcd.gz/.ply/.bin files, one scan each, in name order. Stamps: the file
     name when it is an integer (ns), else DEFAULT_PERIOD_NS apart."""
 
@@ -115,12 +122,3 @@ class PointCloudFolder(Dataset):
         else:
             self._stamps = [(i + 1) * DEFAULT_PERIOD_NS for i in range(len(self._files))]
 
-    def __len__(self) -> int:
-        return len(self._files)
-
-    def scan(self, i: int) -> farlio.Scan:
-        period = self._stamps[i] - self._stamps[i - 1] if i > 0 else DEFAULT_PERIOD_NS
-        return _with_stamps(_core.io.read_point_cloud(self._files[i]), self._stamps[i] - period, self._stamps[i])
-
-    def scan_source(self, i: int) -> str:
-        return str(self._files[i])
