@@ -44,49 +44,25 @@ def _stamp_ns(token: str) -> int:
     return int((Decimal(token) * NS_PER_S).to_integral_value())
 
 
-def _quat_xyzw_to_matrix(q: np.ndarray) -> np.ndarray:
-    x, y, z, w = (q / np.linalg.norm(q, axis=1, keepdims=True)).T
-    r = np.empty((len(q), 3, 3))
-    r[:, 0, 0] = 1 - 2 * (y * y + z * z)
-    r[:, 0, 1] = 2 * (x * y - z * w)
-    r[:, 0, 2] = 2 * (x * z + y * w)
-    r[:, 1, 0] = 2 * (x * y + z * w)
-    r[:, 1, 1] = 1 - 2 * (x * x + z * z)
-    r[:, 1, 2] = 2 * (y * z - x * w)
-    r[:, 2, 0] = 2 * (x * z - y * w)
-    r[:, 2, 1] = 2 * (y * z + x * w)
-    r[:, 2, 2] = 1 - 2 * (x * x + y * y)
-    return r
-
-
 def read_tum(path: Path) -> tuple[np.ndarray, np.ndarray]:
-    """TUM file -> (stamps_ns (N,) int64, poses (N, 4, 4))."""
-    rows = _data_rows(path)
-    if any(len(r) != TUM_COLUMNS for r in rows):
-        raise ValueError(f"{path}: a TUM line needs {TUM_COLUMNS} columns: t x y z qx qy qz qw")
-    stamps = np.array([_stamp_ns(r[0]) for r in rows], dtype=np.int64)
-    values = np.array([[float(v) for v in r[1:]] for r in rows])
-    poses = np.tile(np.eye(4), (len(rows), 1, 1))
-    poses[:, :3, :3] = _quat_xyzw_to_matrix(values[:, 3:])
-    poses[:, :3, 3] = values[:, :3]
-    return stamps, poses
+    """TUM file -> (stamps_ns (N,) int64, poses (N, 4, 4)), through the C++ reader (exact stamps,
+    errors that name the file and line)."""
+    from farlio import _core
+
+    traj = _core.io.read_tum(Path(path))
+    return np.asarray(traj.stamps_ns), traj.matrices()
 
 
 def read_kitti(path: Path, times: Path | None = None) -> tuple[np.ndarray, np.ndarray]:
     """KITTI poses (12 values a line) and an optional times file (seconds a line) -> (stamps_ns, poses).
     Without a times file frame k gets the stamp k * KITTI_FRAME_PERIOD_S."""
-    rows = _data_rows(path)
-    if any(len(r) != KITTI_COLUMNS for r in rows):
-        raise ValueError(f"{path}: a KITTI line needs {KITTI_COLUMNS} values (row-major 3x4)")
-    poses = np.tile(np.eye(4), (len(rows), 1, 1))
-    poses[:, :3, :] = np.array([[float(v) for v in r] for r in rows]).reshape(-1, 3, 4)
-    if times is None:
-        stamps = np.arange(len(rows), dtype=np.int64) * round(KITTI_FRAME_PERIOD_S * NS_PER_S)
-    else:
-        stamps = np.array([_stamp_ns(r[0]) for r in _data_rows(times)], dtype=np.int64)
-        if len(stamps) != len(rows):
-            raise ValueError(f"{times}: {len(stamps)} stamps for {len(rows)} poses in {path}")
-    return stamps, poses
+    from farlio import _core
+
+    stamps = None
+    if times is not None:
+        stamps = [_stamp_ns(r[0]) for r in _data_rows(times)]
+    traj = _core.io.read_kitti(Path(path), stamps)  # without stamps: k * KITTI_FRAME_PERIOD_S
+    return np.asarray(traj.stamps_ns), traj.matrices()
 
 
 def _detect_format(path: Path) -> str:
