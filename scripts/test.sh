@@ -6,6 +6,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 JOBS=${JOBS:-$(nproc)}
+# ccache across clones of the repository (CI builds a fresh clone each time)
+export CCACHE_BASEDIR="$PWD" CCACHE_NOHASHDIR=1 CMAKE_CXX_COMPILER_LAUNCHER=ccache
 
 echo "== C++ build and tests (preset dev) =="
 cmake --preset dev >/dev/null
