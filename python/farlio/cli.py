@@ -14,6 +14,8 @@ COMMANDS = {
     "run": ("farlio.commands.run", "run the odometry over a recording and write trajectories, timings, summary"),
     "simulate": ("farlio.commands.simulate", "generate a LiDAR + IMU sequence with exact ground truth"),
     "eval": ("farlio.commands.evaluate", "compare a trajectory with ground truth (APE, RPE, coverage)"),
+    "ablate": ("farlio.commands.ablate", "component ablation (EKF, DC, MU, SA GICP, ASMD) on a recording"),
+    "latency-sweep": ("farlio.commands.latency_sweep", "APE as the pipeline latency grows (added delays)"),
     "bench": ("farlio.commands.bench", "whole-frame latency next to KISS-ICP on the same scans"),
     "config": ("farlio.commands.config", "print every parameter with its default and meaning (YAML)"),
     "info": ("farlio.commands.info", "print the build (CUDA backend, devices) and version"),

@@ -172,8 +172,8 @@ def run_dataset(dataset: Dataset, out_dir: Path, config: Any = None, *, max_fram
         if stats.accel_in_g:
             _warn(stats.accel_unit_message)
         if stats.imu_gaps:
-            _warn(f"{stats.imu_gaps} IMU gaps (no sample for longer than fusion.imu_gap_limit_s); last: "
-                  f"{stats.last_warning}")
+            _warn(f"{stats.imu_gaps} IMU gap(s): no sample for longer than fusion.imu_gap_limit_s "
+                  "(the last input was held)")
     _evaluate(summary, dataset, out_dir, groundtruth, plot, len(lidar_traj))
     (out_dir / "config.yaml").write_text(config_to_yaml(odo.effective_config))
     summary["voxel_size_m"] = float(odo.effective_config.get("map.voxel_size_m"))

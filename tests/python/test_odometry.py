@@ -149,3 +149,17 @@ def test_scan_pair_through_python_api(shared_data):
     assert np.linalg.norm(e[:3, 3]) < 0.03  # bounds justified in tests/cpp/test_scan_pair.cpp
     assert np.degrees(np.arccos(np.clip((np.trace(e[:3, :3]) - 1) / 2, -1, 1))) < 0.3
     assert res.hessian.shape == (6, 6) and np.all(np.linalg.eigvalsh(res.hessian) > 0)
+
+
+def test_ablation_and_latency_sweep_commands(tmp_path, sequences):
+    seq = sequences("urban", 10.0)
+    assert cli(["ablate", str(seq), "--out", str(tmp_path / "abl"), "--max-frames", "40"]) == 0
+    rows = (tmp_path / "abl" / "ablation.csv").read_text().splitlines()
+    assert rows[0].startswith("components,ape_m,rpe_pct") and len(rows) == 7
+    full = rows[-1].split(",")
+    assert full[0] == "EKF+DC+MU+SA+ASMD" and float(full[1]) < 0.05
+    assert (tmp_path / "abl" / "ablation.md").exists()
+    assert cli(["latency-sweep", str(seq), "--out", str(tmp_path / "sw"), "--delays-ms", "0", "50",
+                "--max-frames", "40"]) == 0
+    sweep = (tmp_path / "sw" / "latency_sweep.csv").read_text().splitlines()
+    assert len(sweep) == 3 and (tmp_path / "sw" / "latency_sweep.png").exists()
