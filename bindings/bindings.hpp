@@ -1,8 +1,21 @@
 #pragma once
 // Each part of the library binds itself into its own submodule of farlio._core.
 #include <nanobind/nanobind.h>
+#include <nanobind/ndarray.h>
+
+#include <initializer_list>
+#include <vector>
 
 namespace farlio::python {
+
+/// A numpy array that owns `values` (moved to the heap, freed with the array), of the given shape.
+template <typename T>
+nanobind::ndarray<nanobind::numpy, T> owned_array(std::vector<T> values, std::initializer_list<std::size_t> shape) {
+  auto* heap = new std::vector<T>(std::move(values));
+  nanobind::capsule owner(heap, [](void* p) noexcept { delete static_cast<std::vector<T>*>(p); });
+  return nanobind::ndarray<nanobind::numpy, T>(heap->data(), shape, owner);
+}
+
 void bind_core(nanobind::module_& m);  // core.cpp: Scan, ImuSample, SE3, Trajectory, Device
 void bind_io(nanobind::module_& m);    // io.cpp: file formats, sequence folder
 void bind_sim(nanobind::module_& m);   // sim.cpp: sequence generator

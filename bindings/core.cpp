@@ -133,22 +133,20 @@ void bind_core(nb::module_& m) {
            })
       .def_prop_ro("stamps_ns",
                    [](const Trajectory& t) {
-                     auto* v = new std::vector<std::int64_t>();
-                     for (const auto& p : t) v->push_back(p.stamp_ns);
-                     nb::capsule owner(v, [](void* p) noexcept { delete static_cast<std::vector<std::int64_t>*>(p); });
-                     return Vector1<std::int64_t>(v->data(), {v->size()}, owner);
+                     std::vector<std::int64_t> v;
+                     for (const auto& p : t) v.push_back(p.stamp_ns);
+                     return owned_array(std::move(v), {t.size()});
                    },
                    nb::rv_policy::move, "(N,) int64 stamps in ns (a copy)")
       .def("matrices",
            [](const Trajectory& t) {
-             auto* v = new std::vector<double>();
-             v->reserve(16 * t.size());
+             std::vector<double> v;
+             v.reserve(16 * t.size());
              for (const auto& p : t) {
                const Eigen::Matrix<double, 4, 4, Eigen::RowMajor> mm = p.pose.matrix();
-               v->insert(v->end(), mm.data(), mm.data() + 16);
+               v.insert(v.end(), mm.data(), mm.data() + 16);
              }
-             nb::capsule owner(v, [](void* p) noexcept { delete static_cast<std::vector<double>*>(p); });
-             return nb::ndarray<nb::numpy, double, nb::shape<-1, 4, 4>>(v->data(), {t.size(), 4, 4}, owner);
+             return owned_array(std::move(v), {t.size(), 4, 4});
            },
            "(N, 4, 4) pose matrices (a copy)")
       .def("interpolate_at", &Trajectory::interpolate_at, "stamp_ns"_a)

@@ -15,25 +15,19 @@ namespace {
 
 using namespace farlio::eval;
 
-template <typename T>
-using Array1 = nb::ndarray<nb::numpy, T, nb::ndim<1>>;
-using Array2 = nb::ndarray<nb::numpy, double, nb::ndim<2>>;
 
 /// A numpy array owning a copy of `values`.
 template <typename T>
-Array1<T> to_numpy(const std::vector<T>& values) {
-  auto* copy = new std::vector<T>(values);
-  nb::capsule owner(copy, [](void* p) noexcept { delete static_cast<std::vector<T>*>(p); });
-  return Array1<T>(copy->data(), {copy->size()}, owner);
+nb::ndarray<nb::numpy, T> to_numpy(const std::vector<T>& values) {
+  return owned_array(values, {values.size()});
 }
 
 /// (N, 3) array of the positions of `poses` (a copy).
-Array2 positions(const std::vector<SE3>& poses) {
-  auto* v = new std::vector<double>();
-  v->reserve(3 * poses.size());
-  for (const auto& p : poses) v->insert(v->end(), p.translation().data(), p.translation().data() + 3);
-  nb::capsule owner(v, [](void* p) noexcept { delete static_cast<std::vector<double>*>(p); });
-  return Array2(v->data(), {poses.size(), 3}, owner);
+nb::ndarray<nb::numpy, double> positions(const std::vector<SE3>& poses) {
+  std::vector<double> v;
+  v.reserve(3 * poses.size());
+  for (const auto& p : poses) v.insert(v.end(), p.translation().data(), p.translation().data() + 3);
+  return owned_array(std::move(v), {poses.size(), 3});
 }
 
 void bind_options(nb::module_& m) {

@@ -13,13 +13,6 @@ using namespace nb::literals;
 
 namespace farlio::python {
 namespace {
-/// A numpy array owning a heap copy of `values` (shape given).
-template <typename T>
-nb::ndarray<nb::numpy, T> owned_array(std::vector<T> values, std::initializer_list<std::size_t> shape) {
-  auto* heap = new std::vector<T>(std::move(values));
-  nb::capsule owner(heap, [](void* p) noexcept { delete static_cast<std::vector<T>*>(p); });
-  return nb::ndarray<nb::numpy, T>(heap->data(), shape, owner);
-}
 }  // namespace
 
 void bind_sim(nb::module_& m) {
