@@ -65,6 +65,8 @@ def run_dataset(dataset: Dataset, out_dir: Path, config: Any = None, *, max_fram
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     config = config or _core.Config()
+    # written first so that a run that dies still says its parameters; rewritten at the end
+    # with the effective values (the voxel size is fixed at the first scan)
     (out_dir / "config.yaml").write_text(config_to_yaml(config))
     for w in dataset.warnings():
         _warn(w)

@@ -138,7 +138,7 @@ OdometryFrame Odometry::process(const Scan& scan) {
     const bool has_velocity = last_body_.has_value() && scan.end_stamp_ns > last_body_->stamp_ns;
     if (has_velocity) {  // eq. (6) on the body poses
       const double dt = static_cast<double>(scan.end_stamp_ns - last_body_->stamp_ns) / kNsPerS;
-      velocity = out.body_pose.rotation().transpose() * (out.body_pose.translation() - last_body_->pose.translation()) / dt;
+      velocity = velocity_from_poses(last_body_->pose, out.body_pose, dt);
     }
     fusion_->add_lidar(scan.end_stamp_ns, out.body_pose, velocity, has_velocity);
     out.fused = true;

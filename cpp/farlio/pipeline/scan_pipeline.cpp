@@ -141,7 +141,7 @@ FrameResult ScanPipeline::process(const Scan& scan, const std::optional<SE3>& in
   // 5. velocity from consecutive poses (eq. 6) and the constant-velocity state
   if (frames_ > 0 && scan.end_stamp_ns > last_stamp_ns_) {
     const double dt = static_cast<double>(scan.end_stamp_ns - last_stamp_ns_) / kNsPerS;
-    out.velocity_body_m_s = pose.rotation().transpose() * (pose.translation() - last_pose_.translation()) / dt;
+    out.velocity_body_m_s = velocity_from_poses(last_pose_, pose, dt);
     out.angular_velocity_body_rad_s = (last_pose_.inverse() * pose).log().tail<3>() / dt;
   }
   prev_pose_ = last_pose_;

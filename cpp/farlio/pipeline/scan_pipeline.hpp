@@ -47,6 +47,12 @@ struct FrameResult {
   FrameTimings timings;
 };
 
+/// Eq. (6): the velocity in the frame of `current`, from the translation between two poses dt_s
+/// apart.
+inline Eigen::Vector3d velocity_from_poses(const SE3& previous, const SE3& current, double dt_s) {
+  return current.rotation().transpose() * (current.translation() - previous.translation()) / dt_s;
+}
+
 class ScanPipeline {
  public:
   /// `initial_pose`: pose of the LiDAR in the world at the first scan.
