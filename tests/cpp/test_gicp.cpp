@@ -84,7 +84,8 @@ INSTANTIATE_TEST_SUITE_P(Perturbations, GicpRecovers,
                                            std::make_tuple(0.0, 5.0), std::make_tuple(0.5, 5.0)));
 
 TEST(Gicp, PointToPointFallbackWithoutCovariance) {
-  // A source point without a covariance is weighted by Omega = I (Sigma_r = I, Sigma_s = 0).
+  // With sparse_point_to_point (the paper's sparsity-aware GICP), a source point without a
+  // covariance is weighted by Omega = I (Sigma_r = I, Sigma_s = 0); by default it is left out.
   exec::CpuExecutor ex(1);
   map::VoxelMap target(VoxelMapConfig{}, ex);
   target.insert(test::sample_scene(60000, 3), Eigen::Vector3f::Zero(), map::PointLimit::constant(40));
@@ -93,6 +94,8 @@ TEST(Gicp, PointToPointFallbackWithoutCovariance) {
   map::Cov3 c = map::Cov3::from(Eigen::Matrix3f::Identity() * 0.01f);
   FactorTerms f_cov{}, f_p2p{};
   ASSERT_TRUE(gicp_factor(target.view(), with_cov, c, fp, f_cov));
+  EXPECT_FALSE(gicp_factor(target.view(), without, c, fp, f_p2p));
+  fp.sparse_point_to_point = true;
   ASSERT_TRUE(gicp_factor(target.view(), without, c, fp, f_p2p));
   // point-to-point: the translation block of H is w * I (kernel weight ~1 with a huge kappa)
   EXPECT_NEAR(f_p2p.H[0], 1.0f, 1e-4f);   // H(0,0)
@@ -107,17 +110,51 @@ TEST(Gicp, PointToPointFallbackWithoutCovariance) {
   for (int k = 0; k < 21; ++k) EXPECT_FLOAT_EQ(f_off.H[k], f_p2p.H[k]);
 }
 
-TEST(Gicp, SparseSourceStillRegisters) {
-  // Isolated floor points have fewer than k neighbours, so they get no covariance.
+class SparseSource : public ::testing::TestWithParam<bool> {};
+
+TEST_P(SparseSource, StillRegisters) {
+  // Isolated floor points have fewer than k neighbours, so they get no covariance; the scan
+  // registers with farlio's defaults and with the paper's variant (point-to-point factors for
+  // them, line pairs kept).
   Problem pb(make_pose(0.5, 0.2, 0.0, 3.0), true);
   std::size_t without = 0;
-  for (const auto& p : pb.source.points) without += p.w() > 0 ? 0 : 1;
+  for (const auto& p : pb.source.points) without += map::has_covariance(p) ? 0 : 1;
   EXPECT_GE(without, 20u) << "the fallback must be exercised";
   const SE3 guess = pb.truth * make_pose(0.3, -0.2, 0.1, 2.0);
-  const auto res = register_scan(pb.source, pb.target.view(), guess, Thresholds::from_sigma(1.0), RegistrationConfig{},
-                                 kNoBudget, pb.ex);
+  RegistrationConfig cfg;
+  cfg.sparse_point_to_point = GetParam();
+  cfg.skip_line_pairs = !GetParam();
+  const auto res = register_scan(pb.source, pb.target.view(), guess, Thresholds::from_sigma(1.0), cfg, kNoBudget, pb.ex);
   EXPECT_LT(trans_err(res.pose, pb.truth), 0.05);
   EXPECT_LT(rot_err_deg(res.pose, pb.truth), 0.2);
+}
+
+INSTANTIATE_TEST_SUITE_P(PointToPointFallback, SparseSource, ::testing::Bool());
+
+TEST(Gicp, PairsOfLineLikeCovariancesAreLeftOut) {
+  // A map holding one line along y (a scan line on the ground seen from one place). A line-like
+  // source point matched to it gives no factor with skip_line_pairs; a surface-like one does.
+  exec::CpuExecutor ex(1);
+  std::vector<Eigen::Vector3f> lines;
+  for (int j = 0; j < 40; ++j) lines.emplace_back(10.0f, -6.0f + 0.3f * static_cast<float>(j), 0.0f);
+  map::VoxelMap target(VoxelMapConfig{}, ex);
+  target.insert(lines, Eigen::Vector3f::Zero(), map::PointLimit::constant(40));
+  std::size_t line_like = 0, valid_covs = 0;
+  target.for_each_point([&](const Eigen::Vector3f&, const map::Cov3& c, bool valid) {
+    valid_covs += valid ? 1 : 0;
+    line_like += valid && map::classify_shape(c.matrix(), 10.0f) == map::PointShape::Line ? 1 : 0;
+  });
+  EXPECT_GE(valid_covs, 8u);
+  EXPECT_EQ(line_like, valid_covs) << "every covariance of a lone line is line-like";
+  FactorParams fp{Eigen::Matrix3f::Identity(), Eigen::Vector3f(0.1f, 0.0f, 0.0f), 4.0f, CauchyKernel{1.0f}, true};
+  const map::Cov3 c = map::Cov3::from(Eigen::Matrix3f::Identity());
+  const Eigen::Vector4f line_src(10.0f, 0.0f, 0.0f, map::shape_code(map::PointShape::Line));
+  const Eigen::Vector4f surface_src(10.0f, 0.0f, 0.0f, map::shape_code(map::PointShape::Surface));
+  FactorTerms f{};
+  EXPECT_FALSE(gicp_factor(target.view(), line_src, c, fp, f));
+  EXPECT_TRUE(gicp_factor(target.view(), surface_src, c, fp, f));
+  fp.skip_line_pairs = false;
+  EXPECT_TRUE(gicp_factor(target.view(), line_src, c, fp, f));
 }
 
 TEST(Gicp, TimeBudgetStopsIt) {

@@ -28,6 +28,10 @@ struct VoxelMapConfig {
   double point_spacing_m = 0.0;
   int covariance_neighbors = 10;       ///< k nearest neighbours for a point covariance (paper: 10)
   double covariance_epsilon = 1e-3;    ///< C = Sigma_hat + eps * I before Frobenius normalisation (eq. 1)
+  /// A covariance is line-like when, after regularisation, its middle eigenvalue is below this
+  /// ratio times the smallest while the largest is above it (points along one scan line or a
+  /// pole). 0: never classify (every covariance counts as a surface).
+  double line_eigenvalue_ratio = 10.0;
   double removal_radius_m = 1000.0;    ///< voxels whose centre is farther from the pose are removed
   /// Recompute the covariances of existing points in voxels that received new points (the
   /// reference never refreshes them).
@@ -54,7 +58,14 @@ struct ThresholdConfig {
 
 /// Sparsity-aware GICP (scan to submap).
 struct RegistrationConfig {
-  bool sparsity_aware = true;           ///< GICP with point-to-point fallback; false: point-to-point only
+  bool sparsity_aware = true;           ///< GICP (true) or plain point-to-point ICP for every point (false)
+  /// Points without a covariance (too few neighbours) enter as point-to-point factors, as the
+  /// paper's sparsity-aware GICP does (true), or are left out (false, default): with a repeating
+  /// scan pattern they pin the scan to where the pattern was recorded (docs/odometry.md).
+  bool sparse_point_to_point = false;
+  /// Leave out correspondences whose two covariances are both line-like (map.line_eigenvalue_ratio):
+  /// two scan lines recorded from the same place fake a constraint across the line.
+  bool skip_line_pairs = true;
   int max_iterations = 500;
   double convergence_norm = 5e-3;       ///< stop when |dx| (6-vector, m and rad) falls below this
   double time_budget_factor = 2.0;      ///< time budget = factor * LiDAR period (paper: 2)

@@ -217,6 +217,7 @@ void VoxelMap::compute_covariances(const std::vector<std::int32_t>& voxels, cons
   const MapView v = view();
   const int k = config_.covariance_neighbors;
   const auto eps = static_cast<float>(config_.covariance_epsilon);
+  const auto line_ratio = static_cast<float>(config_.line_eigenvalue_ratio);
   executor_->for_each(voxels.size(), [&](std::size_t i) {
     const std::int32_t vox = voxels[i];
     const std::int32_t count = v.voxel_counts[vox];
@@ -227,13 +228,14 @@ void VoxelMap::compute_covariances(const std::vector<std::int32_t>& voxels, cons
       const Eigen::Vector3f p = v.points[pi].head<3>();
       const int found = knn_search(v, p, k, std::numeric_limits<float>::max(), idx, d2);
       if (found < k) {
-        v.points[pi].w() = 0.0f;
+        v.points[pi].w() = shape_code(PointShape::NoCovariance);
         continue;
       }
       CovarianceAccumulator acc(p);
       for (int n = 0; n < found; ++n) acc.add(v.points[idx[n]].head<3>());
-      v.covs[pi] = Cov3::from(regularize_frobenius(acc.covariance(), eps));
-      v.points[pi].w() = 1.0f;
+      const Eigen::Matrix3f cov = regularize_frobenius(acc.covariance(), eps);
+      v.covs[pi] = Cov3::from(cov);
+      v.points[pi].w() = shape_code(classify_shape(cov, line_ratio));
     }
   });
 }
@@ -289,7 +291,7 @@ void VoxelMap::for_each_point(const std::function<void(const Eigen::Vector3f&, c
   for (std::size_t v = 0; v < high_water_; ++v) {
     for (std::size_t j = 0; j < static_cast<std::size_t>(voxel_counts_[v]); ++j) {
       const Eigen::Vector4f& p = points_[v * n + j];
-      f(p.head<3>(), covs_[v * n + j], p.w() > 0.0f);
+      f(p.head<3>(), covs_[v * n + j], has_covariance(p));
     }
   }
 }

@@ -44,13 +44,16 @@ SourceCloud source_from_map(const map::MapView& m, std::size_t voxel_capacity) {
 }
 
 LinearSystem build_linear_system(const SourceCloud& source, const map::MapView& target, const SE3& T,
-                                 const Thresholds& th, bool sparsity_aware, exec::CpuExecutor& executor) {
+                                 const Thresholds& th, const RegistrationConfig& config,
+                                 exec::CpuExecutor& executor) {
   FactorParams fp;
   fp.R = T.rotation().cast<float>();
   fp.t = T.translation().cast<float>();
   fp.max_correspondence_distance2 = static_cast<float>(th.max_correspondence_m * th.max_correspondence_m);
   fp.kernel.kappa_m = static_cast<float>(th.kernel_scale_m);
-  fp.sparsity_aware = sparsity_aware;
+  fp.sparsity_aware = config.sparsity_aware;
+  fp.sparse_point_to_point = config.sparse_point_to_point;
+  fp.skip_line_pairs = config.skip_line_pairs;
   Accum zero{};
   const Accum sum = executor.reduce(
       source.size(), zero,
@@ -81,7 +84,7 @@ RegistrationResult register_scan(const SourceCloud& source, const map::MapView& 
   RegistrationResult res;
   res.pose = initial_guess;
   for (int it = 0; it < config.max_iterations; ++it) {
-    res.system = build_linear_system(source, target, res.pose, th, config.sparsity_aware, executor);
+    res.system = build_linear_system(source, target, res.pose, th, config, executor);
     res.iterations = it + 1;
     if (res.system.inliers == 0) break;  // nothing to register against: not converged
     const Mat6d H = res.system.H + config.damping * Mat6d::Identity();

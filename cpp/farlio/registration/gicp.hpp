@@ -13,7 +13,7 @@
 
 namespace farlio::registration {
 
-/// Registration input: points in the sensor frame, w = 1 where the covariance is valid.
+/// Registration input: points in the sensor frame, w = their map::PointShape.
 struct SourceCloud {
   std::vector<Eigen::Vector4f> points;
   std::vector<map::Cov3> covs;
@@ -41,7 +41,8 @@ struct Thresholds {
 
 /// The linear system of `source` at pose T against the map.
 LinearSystem build_linear_system(const SourceCloud& source, const map::MapView& target, const SE3& T,
-                                 const Thresholds& th, bool sparsity_aware, exec::CpuExecutor& executor);
+                                 const Thresholds& th, const RegistrationConfig& config,
+                                 exec::CpuExecutor& executor);
 
 RegistrationResult register_scan(const SourceCloud& source, const map::MapView& target, const SE3& initial_guess,
                                  const Thresholds& th, const RegistrationConfig& config, double time_budget_s,
