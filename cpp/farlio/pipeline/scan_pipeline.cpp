@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <stdexcept>
 
 #include "farlio/pipeline/preprocess.hpp"
 
@@ -37,6 +38,11 @@ ScanPipeline::ScanPipeline(const Config& config, const SE3& initial_pose)
       initial_pose_(initial_pose),
       last_pose_(initial_pose),
       prev_pose_(initial_pose) {}
+
+void ScanPipeline::reset_initial_pose(const SE3& initial_pose) {
+  if (frames_ > 0) throw std::logic_error("ScanPipeline::reset_initial_pose after the first scan");
+  initial_pose_ = last_pose_ = prev_pose_ = initial_pose;
+}
 
 registration::Vec6d ScanPipeline::last_twist() const {
   if (frames_ < 2 || last_stamp_ns_ <= prev_stamp_ns_) return registration::Vec6d::Zero();

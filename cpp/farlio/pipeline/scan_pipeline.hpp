@@ -63,6 +63,9 @@ class ScanPipeline {
   FrameResult process(const Scan& scan, const std::optional<SE3>& initial_guess = std::nullopt,
                       const std::optional<deskew::ScanMotion>& motion = std::nullopt);
 
+  /// Replaces the initial pose; only before the first scan (throws std::logic_error after).
+  void reset_initial_pose(const SE3& initial_pose);
+
   [[nodiscard]] const map::VoxelMap& local_map() const { return map_; }
   /// The effective parameters (the voxel size is fixed at the first scan when auto).
   [[nodiscard]] const Config& config() const { return config_; }
