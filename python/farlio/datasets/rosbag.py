@@ -78,6 +78,8 @@ def describe_topics(reader: Any) -> str:
 
 def bag_messages(reader: Any, path: Path, connections: list[Any]) -> Iterator[tuple[Any, int, Any]]:
     """(connection, bag time ns, deserialised message); read errors become BagError naming the bag."""
+    if not connections:  # rosbags reads every topic when given none
+        return
     it = reader.messages(connections=connections)
     while True:
         try:
@@ -138,6 +140,7 @@ class RosBag(Dataset):
         firsts = [self._first_cloud(t) for t in self.lidar_topics]
         self.frames = [_frame(m.header.frame_id) for m in firsts]
         for topic, msg in zip(self.lidar_topics, firsts):
+            decode(msg, f"{self.path} topic {topic} first message", self.options.time)  # bad fields fail here
             if time_field_of(msg, self.options.time) is None:
                 self._warnings.append(f"{self.path}: topic {topic} has no per-point time field (fields: "
                                       f"{', '.join(field_names(msg))}; looked for {', '.join(TIME_FIELDS)}): "
