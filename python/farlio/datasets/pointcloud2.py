@@ -185,7 +185,8 @@ def decode(msg: Any, where: str, options: TimeOptions | None = None) -> Cloud:
         if pts.dtype[c].shape:
             raise CloudError(f"{where}: field '{c}' has count {pts.dtype[c].shape[0]}; expected 1")
         xyz[:, k] = pts[c]
-    keep = np.any(xyz != 0.0, axis=1)
+    origin = (xyz[:, 0] == 0.0) & (xyz[:, 1] == 0.0) & (xyz[:, 2] == 0.0)  # no return
+    keep = np.flatnonzero(~origin) if origin.any() else slice(None)
     xyz = xyz[keep]
     header_ns = stamp_ns(msg.header)
     inten_name = next((n for n in INTENSITY_FIELDS if n in names and not pts.dtype[n].shape), None)

@@ -355,9 +355,10 @@ class RosBag(Dataset):
                 ids.append(np.full(int(sel.sum()), k, np.uint8))
             while q and q[0][1].max(initial=0) < end:
                 q.popleft()
-        points = np.ascontiguousarray(np.concatenate(pts), dtype=np.float32)
-        time_s = np.concatenate(times).astype(np.float32) if self._has_time and all(
-            t is not None for t in times) else None
-        return farlio.Scan(points, time_s=time_s, intensity=np.concatenate(inten).astype(np.float32),
+        def joined(parts: list[np.ndarray]) -> np.ndarray:
+            return parts[0] if len(parts) == 1 else np.concatenate(parts)
+        points = np.ascontiguousarray(joined(pts), dtype=np.float32)
+        time_s = joined(times).astype(np.float32) if self._has_time and all(t is not None for t in times) else None
+        return farlio.Scan(points, time_s=time_s, intensity=np.ascontiguousarray(joined(inten), dtype=np.float32),
                            start_stamp_ns=start, end_stamp_ns=end,
                            sensor_id=np.concatenate(ids) if len(self.lidar_topics) > 1 else None)
