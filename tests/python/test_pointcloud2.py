@@ -7,7 +7,9 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from farlio.datasets.pointcloud2 import CloudError, TimeOptions, decode
+pytest.importorskip("farlio._core")
+
+from farlio.datasets.pointcloud2 import CloudError, TimeOptions, decode  # noqa: E402
 
 POINTS = 64
 HEADER_NS = 1_700_000_000_123_456_789
