@@ -18,13 +18,16 @@ from farlio.cli import main  # noqa: E402
 from farlio.datasets import LoadOptions, TimeOptions, detect_format, open_dataset  # noqa: E402
 from farlio.datasets.rosbag import BagError  # noqa: E402
 from farlio.datasets.rosbag_write import BagWriter, write_dataset  # noqa: E402
-from farlio.runner import run_dataset  # noqa: E402
+from farlio.runner import replay_options, run_dataset  # noqa: E402
 from farlio.simulation import make_config, write_sequence  # noqa: E402
 
 SIM_DURATION_S = 2.0
 SIM_SEED = 11
-#: the bag path must reproduce the folder's poses to this (pipeline threads alone vary ~0.1 mm)
+#: the bag path must reproduce the folder's poses to this
 POSE_TOLERANCE_M = 1e-3
+#: a fixed result latency makes the replay deterministic (the measured one varies with the load)
+FIXED_LATENCY_S = 0.01
+DETERMINISTIC = replay_options("fixed", FIXED_LATENCY_S)
 #: merged scans hold the same points in another order: the voxel filter keeps other representatives
 MERGED_POSE_TOLERANCE_M = 1e-2
 #: the second LiDAR's scans start this much later than the first's
@@ -43,12 +46,12 @@ def sequence(tmp_path_factory) -> Path:
 @pytest.fixture(scope="module")
 def reference(sequence, tmp_path_factory) -> np.ndarray:
     out = tmp_path_factory.mktemp("ref")
-    run_dataset(open_dataset(sequence), out, progress=False, plot=False)
+    run_dataset(open_dataset(sequence), out, progress=False, plot=False, options=DETERMINISTIC)
     return np.loadtxt(out / "scans_body.tum")
 
 
 def run_poses(dataset, out: Path) -> np.ndarray:
-    run_dataset(dataset, out, progress=False, plot=False)
+    run_dataset(dataset, out, progress=False, plot=False, options=DETERMINISTIC)
     return np.loadtxt(out / "scans_body.tum")
 
 
