@@ -25,14 +25,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     rec = parser.add_argument_group("recordings (bags, Ouster, calibration)")
     rec.add_argument("--lidar-topic", dest="lidar_topics", action="append", default=[], metavar="TOPIC",
                      help="PointCloud2 topic of a bag (or Ouster lidar_packets topic); repeat it to merge several "
-                          "LiDARs into one scan per period of the first (default: the bag's only PointCloud2 topic)")
+                          "LiDARs into one scan per period of the first; not given: the bag's only PointCloud2 topic")
     rec.add_argument("--imu-topic", default=None, metavar="TOPIC",
-                     help="sensor_msgs/Imu topic of a bag (default: the bag's only Imu topic; 'none': LiDAR-only)")
+                     help="sensor_msgs/Imu topic of a bag ('none': LiDAR-only); not given: the bag's only Imu topic")
     rec.add_argument("--calib", type=Path, default=None, metavar="YAML",
                      help="extrinsics file with T_imu_lidar (4x4, or {topic: 4x4} for several LiDARs); overrides "
                           "/tf_static and the recording's own calibration")
     rec.add_argument("--meta", type=Path, default=None, metavar="JSON",
-                     help="Ouster sensor metadata (default: the .pcap's name with .json, or the bag's metadata topic)")
+                     help="Ouster sensor metadata; not given: the .pcap's name with .json, or the bag's metadata topic")
     rec.add_argument("--time-field", default="auto", metavar="NAME",
                      help=f"PointCloud2 per-point time field ('auto': first of {', '.join(TIME_FIELDS)}; "
                           f"'none': no per-point time, no undistortion)")

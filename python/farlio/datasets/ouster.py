@@ -228,6 +228,8 @@ class OusterRecording(Dataset):
         return f"{self.path} frame {i}"
 
     def imu(self) -> list[farlio.ImuSample]:
+        if self.options.imu_topic == "none":
+            return []
         return self._imu if self.path.suffix == PCAP_SUFFIX or self.imu_topic else []
 
     def T_imu_lidar(self) -> farlio.SE3:

@@ -215,6 +215,11 @@ class RosBag(Dataset):
         samples.sort(key=lambda s: s.stamp_ns)
         return samples
 
+    def gravity_m_s2(self) -> float:
+        if self.options.calib is not None and CalibFile(self.options.calib).gravity_m_s2 is not None:
+            return CalibFile(self.options.calib).gravity_m_s2
+        return super().gravity_m_s2()
+
     def _read_extrinsics(self) -> list[farlio.SE3]:
         if self.options.calib is not None:
             calib = CalibFile(self.options.calib)
