@@ -1,5 +1,6 @@
 """The real recordings in ../shared/data/real through `farlio run` and the dataloaders: Ouster pcaps
-(+ json) and the Ouster ROS 1 packet bag with their IMU packets, and the 16 KITTI scans. Skipped
+(+ json) and the Ouster ROS 1 packet bag with their IMU packets, the Ouster OSF file, and the 16
+KITTI scans. Skipped
 without ../shared/data (or without ouster-sdk for the Ouster files)."""
 from __future__ import annotations
 
@@ -29,6 +30,11 @@ ACCEL_NORM_TOLERANCE = 1.5
 OUSTER_POSE_TOLERANCE_M = 0.2
 ANGLE_TOLERANCE_DEG = 1.0
 KITTI_SCANS = 16
+OSF_FILE, OSF_SCANS = "osf_fw_3.2_10scans.osf", 10
+#: a vehicle at ~8 m/s: every step between scans within this factor of the median step, and
+#: consecutive steps in nearly the same direction (6k-point scans: the first ones vary by ~30%)
+STEP_RATIO_LIMIT = 1.5
+MIN_STEP_COSINE = 0.95
 #: a car: under 40 m/s, so under 4 m between 10 Hz scans
 MAX_STEP_M = 4.0
 
@@ -113,3 +119,18 @@ def test_kitti_scans_give_a_sane_trajectory(shared_data, tmp_path):
     # a car drives forward (LiDAR x) and stays on the ground plane
     travel = poses[-1, 1:4] - poses[0, 1:4]
     assert travel[0] > 0.5 * np.linalg.norm(travel) and abs(travel[2]) < 0.1 * np.linalg.norm(travel) + 0.5
+
+
+def test_ouster_osf_gives_a_steady_trajectory(ouster_dir, tmp_path):
+    osf = ouster_dir / OSF_FILE
+    assert detect_format(osf) == "ouster"
+    summary = run_cli(osf, tmp_path / "run")
+    assert summary["processed"] == OSF_SCANS and summary["converged_fraction"] == 1.0
+    poses = np.loadtxt(tmp_path / "run" / "scans_lidar.tum")
+    steps = np.diff(poses[:, 1:4], axis=0)
+    assert np.all(np.linalg.norm(steps, axis=1) < MAX_STEP_M)
+    lengths = np.linalg.norm(steps, axis=1)
+    ratio = lengths / np.median(lengths)
+    assert np.all(ratio < STEP_RATIO_LIMIT) and np.all(ratio > 1.0 / STEP_RATIO_LIMIT)
+    cosines = np.sum(steps[1:] * steps[:-1], axis=1) / (lengths[1:] * lengths[:-1])
+    assert np.all(cosines > MIN_STEP_COSINE)

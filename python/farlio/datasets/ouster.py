@@ -1,5 +1,6 @@
-"""Ouster recordings: a packet capture (.pcap) with its sensor metadata (.json), or a ROS bag of
-raw ouster-ros packets (lidar_packets, imu_packets and metadata topics). Packets are decoded by
+"""Ouster recordings: a packet capture (.pcap) with its sensor metadata (.json), an OSF file
+(Ouster's own format: frames and metadata, no IMU), or a ROS bag of raw ouster-ros packets
+(lidar_packets, imu_packets and metadata topics). Packets are decoded by
 the `ouster-sdk` package (its packet formats, frame batcher and XYZ lookup table); the bag itself
 is read with `rosbags`.
 
@@ -24,6 +25,7 @@ from .base import Dataset, LoadOptions
 from .rosbag import OUSTER_PACKET_TYPES, bag_messages, describe_topics, is_bag_path, open_bag
 
 PCAP_SUFFIX = ".pcap"
+OSF_SUFFIX = ".osf"
 MM_PER_M = 1000.0
 NS_PER_S = 1_000_000_000
 #: measurement-block status bit that marks a valid column
@@ -58,7 +60,7 @@ class OusterRecording(Dataset):
     @classmethod
     def matches(cls, path: Path) -> bool:
         path = Path(path)
-        if path.is_file() and path.suffix == PCAP_SUFFIX:
+        if path.is_file() and path.suffix in (PCAP_SUFFIX, OSF_SUFFIX):
             return True
         if not is_bag_path(path):
             return False
@@ -78,6 +80,8 @@ class OusterRecording(Dataset):
         if self.path.suffix == PCAP_SUFFIX:
             self.meta_path = self._find_meta()
             self.info = self._parse_meta(self.meta_path.read_text(), str(self.meta_path))
+        elif self.path.suffix == OSF_SUFFIX:
+            self.info = self._osf_source().sensor_info[0]
         else:
             self._open_bag()
         self._pf = self._core.PacketFormat(self.info)
@@ -152,6 +156,13 @@ class OusterRecording(Dataset):
                 raise ValueError(f"{self.path}: topic {meta[0]} has no message")
             self.info = self._parse_meta(msg.data, f"{self.path} topic {meta[0]}")
 
+    def _osf_source(self) -> Any:
+        from ouster.sdk.osf import OsfFrameSetSource
+        try:
+            return OsfFrameSetSource(str(self.path))
+        except Exception as e:  # the SDK raises RuntimeError on a bad file
+            raise ValueError(f"{self.path}: cannot read as an Ouster OSF file ({e})") from None
+
     def _packets(self) -> Iterator[Any]:
         core = self._core
         if self.path.suffix == PCAP_SUFFIX:
@@ -179,6 +190,13 @@ class OusterRecording(Dataset):
     def _frames(self) -> Iterator[Any]:
         """IMU samples and complete LidarFrames, in recording order."""
         core = self._core
+        if self.path.suffix == OSF_SUFFIX:  # frames already batched; the first sensor of each set
+            for frame_set in self._osf_source():
+                for frame in frame_set:
+                    if frame is not None:
+                        yield frame
+                    break
+            return
         batcher = core.FrameBatcher(self.info)
         frame = core.LidarFrame(self.info)
         for packet in self._packets():
@@ -228,9 +246,7 @@ class OusterRecording(Dataset):
         return f"{self.path} frame {i}"
 
     def imu(self) -> list[farlio.ImuSample]:
-        if self.options.imu_topic == "none":
-            return []
-        return self._imu if self.path.suffix == PCAP_SUFFIX or self.imu_topic else []
+        return [] if self.options.imu_topic == "none" else self._imu
 
     def T_imu_lidar(self) -> farlio.SE3:
         m = np.array(self.info.imu_to_sensor_transform, dtype=np.float64)
