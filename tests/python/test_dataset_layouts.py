@@ -14,7 +14,7 @@ core = pytest.importorskip("farlio._core")
 
 import farlio  # noqa: E402
 from farlio.datasets import detect_format, open_dataset  # noqa: E402
-from farlio.datasets.kitti_raw import OXTS_COLUMNS, parse_kitti_stamp  # noqa: E402
+from farlio.datasets.kitti_raw import EARTH_RADIUS_M, OXTS_COLUMNS, parse_kitti_stamp  # noqa: E402
 from farlio.runner import replay_options, run_dataset  # noqa: E402
 from farlio.simulation import make_config, write_sequence  # noqa: E402
 
@@ -25,6 +25,10 @@ POSE_TOLERANCE_M = 1e-3
 FIXED_LATENCY_S = 0.01
 DETERMINISTIC = replay_options("fixed", FIXED_LATENCY_S)
 OXTS_ACCEL, OXTS_GYRO = 11, 17   # first column of ax ay az and of wx wy wz
+#: where the generated drive is put on the Earth (Karlsruhe), and its altitude
+ORIGIN_LAT_DEG, ORIGIN_LON_DEG, ORIGIN_ALT_M = 49.0, 8.4, 110.0
+#: OXTS positions go through degrees of latitude/longitude and back
+OXTS_POSE_TOLERANCE_M = 1e-6
 NS_PER_S = 1_000_000_000
 
 
@@ -77,8 +81,19 @@ def write_kitti_raw(folder, date_dir: Path) -> Path:
     (drive / "velodyne_points" / "timestamps_start.txt").write_text("\n".join(starts) + "\n")
     (drive / "velodyne_points" / "timestamps_end.txt").write_text("\n".join(ends) + "\n")
     stamps = []
+    truth = core.io.read_tum(folder.path / "groundtruth.tum")
+    first = truth.interpolate_at(folder.imu()[0].stamp_ns).matrix()
+    scale = np.cos(np.radians(ORIGIN_LAT_DEG))
+    x0 = scale * np.radians(ORIGIN_LON_DEG) * EARTH_RADIUS_M
+    y0 = scale * EARTH_RADIUS_M * np.log(np.tan(np.radians(90.0 + ORIGIN_LAT_DEG) / 2.0))
     for k, sample in enumerate(folder.imu()):
         row = np.zeros(OXTS_COLUMNS)
+        w = truth.interpolate_at(sample.stamp_ns).matrix()
+        x, y = x0 + w[0, 3] - first[0, 3], y0 + w[1, 3] - first[1, 3]
+        row[0] = np.degrees(2.0 * np.arctan(np.exp(y / (scale * EARTH_RADIUS_M)))) - 90.0
+        row[1] = np.degrees(x / (scale * EARTH_RADIUS_M))
+        row[2] = ORIGIN_ALT_M + w[2, 3] - first[2, 3]
+        row[3:6] = [np.arctan2(w[2, 1], w[2, 2]), -np.arcsin(w[2, 0]), np.arctan2(w[1, 0], w[0, 0])]
         row[OXTS_ACCEL:OXTS_ACCEL + 3] = sample.accel_m_s2
         row[OXTS_GYRO:OXTS_GYRO + 3] = sample.gyro_rad_s
         (drive / "oxts" / "data" / f"{k:010d}.txt").write_text(" ".join(repr(float(v)) for v in row) + "\n")
@@ -111,8 +126,17 @@ def test_kitti_raw_reads_back_and_matches_the_folder(sequence, tmp_path):
     assert (a.start_stamp_ns, a.end_stamp_ns) == (b.start_stamp_ns, b.end_stamp_ns)
     np.testing.assert_array_equal(a.points, b.points)
     assert any("not undistorted" in w for w in ds.warnings())
+    # ground truth from the OXTS poses: the generated body poses relative to the first sample
+    truth = core.io.read_tum(sequence / "groundtruth.tum")
+    oxts_gt = core.io.read_tum(ds.groundtruth())
+    first_inv = truth.interpolate_at(ref_imu[0].stamp_ns).inverse()
+    for k in range(0, len(oxts_gt), 10):
+        stamp, pose = oxts_gt[k]
+        expected = (first_inv * truth.interpolate_at(stamp)).matrix()
+        np.testing.assert_allclose(pose.matrix(), expected, atol=OXTS_POSE_TOLERANCE_M)
     run_dataset(WithoutTimes(folder), tmp_path / "ref", progress=False, plot=False, options=DETERMINISTIC)
-    run_dataset(ds, tmp_path / "raw", progress=False, plot=False, options=DETERMINISTIC)
+    summary = run_dataset(ds, tmp_path / "raw", progress=False, plot=False, options=DETERMINISTIC)
+    assert summary["accuracy"]["associated_poses"] == len(folder)  # evaluated against the OXTS poses
     ref, got = (np.loadtxt(tmp_path / d / "scans_body.tum") for d in ("ref", "raw"))
     np.testing.assert_array_equal(ref[:, 0], got[:, 0])
     assert np.abs(ref[:, 1:4] - got[:, 1:4]).max() < POSE_TOLERANCE_M

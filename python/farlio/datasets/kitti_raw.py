@@ -6,15 +6,21 @@ Scans have no per-point time (the .bin files do not carry it), so they are not u
 start/end come from velodyne_points/timestamps_start.txt and timestamps_end.txt when present,
 else timestamps.txt is taken as the scan end. The IMU is the OXTS: acceleration ax, ay, az (m/s^2,
 gravity included) and angular rate wx, wy, wz (rad/s) in the OXTS frame (x forward, y left, z up).
+The OXTS poses (latitude, longitude, altitude, roll, pitch, yaw) become the ground truth of the
+body (OXTS) frame, as in the KITTI devkit: Mercator projection with the first latitude's scale,
+rotation Rz(yaw) Ry(pitch) Rx(roll), relative to the first pose (a TUM file in a temporary folder).
 """
 from __future__ import annotations
 
+import math
+import tempfile
 from datetime import datetime, timezone
 from pathlib import Path
 
 import numpy as np
 
 import farlio
+from farlio import _core
 
 from .base import Dataset, LoadOptions
 from .calib import CalibFile, se3_from_matrix
@@ -26,6 +32,9 @@ CALIB_FILE = "calib_imu_to_velo.txt"
 OXTS_ACCEL_COLUMNS = slice(11, 14)   # ax ay az
 OXTS_GYRO_COLUMNS = slice(17, 20)    # wx wy wz
 OXTS_COLUMNS = 30
+OXTS_POSE_COLUMNS = slice(0, 6)      # lat lon alt roll pitch yaw
+#: the Earth radius of the KITTI devkit's Mercator projection
+EARTH_RADIUS_M = 6378137.0
 
 
 def parse_kitti_stamp(text: str, where: str) -> int:
@@ -42,6 +51,22 @@ def parse_kitti_stamp(text: str, where: str) -> int:
 def read_stamps(path: Path) -> list[int]:
     return [parse_kitti_stamp(line, f"{path}:{k + 1}") for k, line in enumerate(path.read_text().splitlines())
             if line.strip()]
+
+
+def oxts_pose(lat_lon_alt_rpy: np.ndarray, scale: float) -> np.ndarray:
+    """The OXTS frame's 4x4 pose in the local Mercator frame (KITTI devkit convertOxtsToPose)."""
+    lat, lon, alt, roll, pitch, yaw = (float(v) for v in lat_lon_alt_rpy)
+    t = [scale * math.radians(lon) * EARTH_RADIUS_M,
+         scale * EARTH_RADIUS_M * math.log(math.tan(math.radians(90.0 + lat) / 2.0)), alt]
+    cr, sr, cp, sp, cy, sy = math.cos(roll), math.sin(roll), math.cos(pitch), math.sin(pitch), math.cos(yaw), \
+        math.sin(yaw)
+    rx = np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]])
+    ry = np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])
+    rz = np.array([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]])
+    m = np.eye(4)
+    m[:3, :3] = rz @ ry @ rx
+    m[:3, 3] = t
+    return m
 
 
 def read_imu_to_velo(path: Path) -> farlio.SE3:
@@ -86,6 +111,9 @@ class KittiRaw(_FilesWithStamps):
             self._starts = None
             self._warnings.append(f"{velo}: no timestamps*.txt: scans assumed {DEFAULT_PERIOD_NS / 1e6:g} ms apart")
         self._warnings.append(f"{self.path}: KITTI scans have no per-point time: they are not undistorted")
+        self._oxts_stamps: list[int] = []
+        self._oxts_poses: list[np.ndarray] = []
+        self._gt: Path | None = None
         self._imu = self._read_oxts()
         self._T_imu_lidar = self._read_extrinsic()
 
@@ -106,6 +134,7 @@ class KittiRaw(_FilesWithStamps):
             raise ValueError(f"{oxts / 'timestamps.txt'}: {len(stamps)} stamps for {len(files)} files in "
                              f"{oxts / 'data'}")
         samples = []
+        self._oxts_stamps = stamps
         for stamp, f in zip(stamps, files):
             v = f.read_text().split()
             if len(v) != OXTS_COLUMNS:
@@ -113,6 +142,7 @@ class KittiRaw(_FilesWithStamps):
             try:
                 a = np.array(v[OXTS_ACCEL_COLUMNS], dtype=np.float64)
                 w = np.array(v[OXTS_GYRO_COLUMNS], dtype=np.float64)
+                self._oxts_poses.append(np.array(v[OXTS_POSE_COLUMNS], dtype=np.float64))
             except ValueError:
                 raise ValueError(f"{f}: a non-numeric acceleration or angular rate") from None
             samples.append(farlio.ImuSample(stamp, w, a))
@@ -137,6 +167,19 @@ class KittiRaw(_FilesWithStamps):
 
     def imu(self) -> list[farlio.ImuSample]:
         return self._imu
+
+    def groundtruth(self) -> Path | None:
+        if not self._oxts_poses:
+            return None
+        if self._gt is None:
+            scale = math.cos(math.radians(self._oxts_poses[0][0]))
+            first_inv = np.linalg.inv(oxts_pose(self._oxts_poses[0], scale))
+            traj = farlio.Trajectory()
+            for stamp, p in zip(self._oxts_stamps, self._oxts_poses):
+                traj.push_back(stamp, farlio.SE3.from_matrix(first_inv @ oxts_pose(p, scale)))
+            self._gt = Path(tempfile.mkdtemp(prefix="farlio-kitti-raw-")) / "groundtruth.tum"
+            _core.io.write_tum(self._gt, traj)
+        return self._gt
 
     def T_imu_lidar(self) -> farlio.SE3:
         return self._T_imu_lidar
