@@ -84,8 +84,8 @@ INSTANTIATE_TEST_SUITE_P(Perturbations, GicpRecovers,
                                            std::make_tuple(0.0, 5.0), std::make_tuple(0.5, 5.0)));
 
 TEST(Gicp, PointToPointFallbackWithoutCovariance) {
-  // With sparse_point_to_point (the paper's sparsity-aware GICP), a source point without a
-  // covariance is weighted by Omega = I (Sigma_r = I, Sigma_s = 0); by default it is left out.
+  // A source point without a covariance is weighted by Omega = lambda I (Sigma_s = 0): the
+  // paper's lambda = 1 here.
   exec::CpuExecutor ex(1);
   map::VoxelMap target(VoxelMapConfig{}, ex);
   target.insert(test::sample_scene(60000, 3), Eigen::Vector3f::Zero(), map::PointLimit::constant(40));
@@ -94,8 +94,6 @@ TEST(Gicp, PointToPointFallbackWithoutCovariance) {
   map::Cov3 c = map::Cov3::from(Eigen::Matrix3f::Identity() * 0.01f);
   FactorTerms f_cov{}, f_p2p{};
   ASSERT_TRUE(gicp_factor(target.view(), with_cov, c, fp, f_cov));
-  EXPECT_FALSE(gicp_factor(target.view(), without, c, fp, f_p2p));
-  fp.sparse_point_to_point = true;
   ASSERT_TRUE(gicp_factor(target.view(), without, c, fp, f_p2p));
   // point-to-point: the translation block of H is w * I (kernel weight ~1 with a huge kappa)
   EXPECT_NEAR(f_p2p.H[0], 1.0f, 1e-4f);   // H(0,0)
@@ -108,28 +106,45 @@ TEST(Gicp, PointToPointFallbackWithoutCovariance) {
   FactorTerms f_off{};
   ASSERT_TRUE(gicp_factor(target.view(), with_cov, c, fp, f_off));
   for (int k = 0; k < 21; ++k) EXPECT_FLOAT_EQ(f_off.H[k], f_p2p.H[k]);
+  // farlio's lambda scales the point-to-point information and nothing else
+  fp.sparsity_aware = true;
+  fp.point_to_point_precision = 0.03f;
+  FactorTerms f_scaled{}, f_cov_again{};
+  ASSERT_TRUE(gicp_factor(target.view(), without, c, fp, f_scaled));
+  ASSERT_TRUE(gicp_factor(target.view(), with_cov, c, fp, f_cov_again));
+  for (int k = 0; k < 21; ++k) EXPECT_NEAR(f_scaled.H[k], 0.03f * f_p2p.H[k], 1e-5f * (1.0f + std::abs(f_p2p.H[k])));
+  for (int k = 0; k < 21; ++k) EXPECT_FLOAT_EQ(f_cov_again.H[k], f_cov.H[k]);
+}
+
+TEST(Gicp, PointToPointPrecisionFollowsTheSpacing) {
+  RegistrationConfig cfg;  // sigma = spacing / sqrt(12)
+  EXPECT_NEAR(point_to_point_precision(cfg, 1e-3, 0.632), 1e-3 * 12.0 / (0.632 * 0.632), 1e-12);
+  cfg.point_to_point_sigma_m = std::sqrt(1e-3);  // the paper's weighting
+  EXPECT_NEAR(point_to_point_precision(cfg, 1e-3, 0.632), 1.0, 1e-12);
 }
 
 class SparseSource : public ::testing::TestWithParam<bool> {};
 
 TEST_P(SparseSource, StillRegisters) {
   // Isolated floor points have fewer than k neighbours, so they get no covariance; the scan
-  // registers with farlio's defaults and with the paper's variant (point-to-point factors for
-  // them, line pairs kept).
+  // registers with farlio's defaults (point-to-point factors weighted by the spacing, line
+  // pairs left out) and with the paper's (Omega = I, line pairs kept).
   Problem pb(make_pose(0.5, 0.2, 0.0, 3.0), true);
   std::size_t without = 0;
   for (const auto& p : pb.source.points) without += map::has_covariance(p) ? 0 : 1;
   EXPECT_GE(without, 20u) << "the fallback must be exercised";
   const SE3 guess = pb.truth * make_pose(0.3, -0.2, 0.1, 2.0);
   RegistrationConfig cfg;
-  cfg.sparse_point_to_point = GetParam();
-  cfg.skip_line_pairs = !GetParam();
-  const auto res = register_scan(pb.source, pb.target.view(), guess, Thresholds::from_sigma(1.0), cfg, kNoBudget, pb.ex);
+  const bool paper = GetParam();
+  cfg.skip_line_pairs = !paper;
+  const double spacing_m = 0.632;
+  const auto th = Thresholds::from_sigma(1.0, paper ? 1.0 : point_to_point_precision(cfg, 1e-3, spacing_m));
+  const auto res = register_scan(pb.source, pb.target.view(), guess, th, cfg, kNoBudget, pb.ex);
   EXPECT_LT(trans_err(res.pose, pb.truth), 0.05);
   EXPECT_LT(rot_err_deg(res.pose, pb.truth), 0.2);
 }
 
-INSTANTIATE_TEST_SUITE_P(PointToPointFallback, SparseSource, ::testing::Bool());
+INSTANTIATE_TEST_SUITE_P(PaperWeighting, SparseSource, ::testing::Bool());
 
 TEST(Gicp, PairsOfLineLikeCovariancesAreLeftOut) {
   // A map holding one line along y (a scan line on the ground seen from one place). A line-like

@@ -46,7 +46,7 @@ TEST_P(ScanPair, RegistersFromPerturbedStarts) {
   Config cfg;
   cfg.map.voxel_size_m = c.voxel_size_m;
   cfg.map.auto_voxel_size = false;  // this test is about these voxel sizes
-  cfg.registration.sparse_point_to_point = c.paper_sparse_handling;
+  if (c.paper_sparse_handling) cfg.registration.point_to_point_sigma_m = std::sqrt(cfg.map.covariance_epsilon);
   cfg.registration.skip_line_pairs = !c.paper_sparse_handling;
   std::vector<SE3> results;
   for (const auto& [offset_m, angle_deg] : {std::pair{0.0, 0.0}, {0.5, 0.0}, {0.0, 5.0}, {0.5, 5.0}, {0.5, -5.0}}) {

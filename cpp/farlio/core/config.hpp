@@ -59,10 +59,12 @@ struct ThresholdConfig {
 /// Sparsity-aware GICP (scan to submap).
 struct RegistrationConfig {
   bool sparsity_aware = true;           ///< GICP (true) or plain point-to-point ICP for every point (false)
-  /// Points without a covariance (too few neighbours) enter as point-to-point factors, as the
-  /// paper's sparsity-aware GICP does (true), or are left out (false, default): with a repeating
-  /// scan pattern they pin the scan to where the pattern was recorded (docs/odometry.md).
-  bool sparse_point_to_point = false;
+  /// Points without a covariance (too few neighbours) enter as point-to-point factors whose
+  /// residual has this standard deviation per axis; 0: the map's point spacing / sqrt(12) (a
+  /// point anywhere within one spacing, 18 cm at 4 m voxels). The paper weights them like a
+  /// surface's normal (Omega = I, i.e. sqrt(map.covariance_epsilon) = 3.2 cm), which lets a few far
+  /// points matched to their own earlier samples pin a scan to a standstill (docs/odometry.md).
+  double point_to_point_sigma_m = 0.0;
   /// Leave out correspondences whose two covariances are both line-like (map.line_eigenvalue_ratio):
   /// two scan lines recorded from the same place fake a constraint across the line.
   bool skip_line_pairs = true;

@@ -122,7 +122,8 @@ FrameResult ScanPipeline::process(const Scan& scan, const std::optional<SE3>& in
   SE3 pose = out.initial_guess;
   if (map_.num_voxels() > 0 && !source.points.empty()) {
     out.registration = registration::register_scan(source, map_.view(), out.initial_guess,
-                                                   registration::Thresholds::from_sigma(out.sigma_m),
+                                                   registration::Thresholds::from_sigma(out.sigma_m, registration::point_to_point_precision(
+                                                       config_.registration, config_.map.covariance_epsilon, map_.spacing_m())),
                                                    config_.registration, config_.registration.time_budget_factor * period_s,
                                                    executor_);
     out.registered = true;

@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 #include <array>
 #include <chrono>
+#include <cmath>
 
 #include "farlio/registration/gicp_factor.hpp"
 
@@ -31,6 +32,13 @@ LinearSystem to_system(const Accum& a) {
 
 }  // namespace
 
+double point_to_point_precision(const RegistrationConfig& config, double covariance_epsilon, double spacing_m) {
+  constexpr double kUniformVariancePerSpacing2 = 1.0 / 12.0;  // variance of a uniform offset over one spacing
+  const double sigma2 = config.point_to_point_sigma_m > 0.0 ? config.point_to_point_sigma_m * config.point_to_point_sigma_m
+                                                            : kUniformVariancePerSpacing2 * spacing_m * spacing_m;
+  return sigma2 > 0.0 ? covariance_epsilon / sigma2 : 1.0;
+}
+
 SourceCloud source_from_map(const map::MapView& m, std::size_t voxel_capacity) {
   SourceCloud src;
   for (std::size_t v = 0; v < voxel_capacity; ++v) {
@@ -52,8 +60,8 @@ LinearSystem build_linear_system(const SourceCloud& source, const map::MapView& 
   fp.max_correspondence_distance2 = static_cast<float>(th.max_correspondence_m * th.max_correspondence_m);
   fp.kernel.kappa_m = static_cast<float>(th.kernel_scale_m);
   fp.sparsity_aware = config.sparsity_aware;
-  fp.sparse_point_to_point = config.sparse_point_to_point;
   fp.skip_line_pairs = config.skip_line_pairs;
+  fp.point_to_point_precision = static_cast<float>(th.point_to_point_precision);
   Accum zero{};
   const Accum sum = executor.reduce(
       source.size(), zero,

@@ -32,12 +32,22 @@ struct RegistrationResult {
 /// The stored points of a map with their covariances (the per-scan frame map gives the source).
 SourceCloud source_from_map(const map::MapView& frame_map, std::size_t voxel_capacity);
 
-/// Correspondence distance (3 sigma) and kernel scale (sigma / 3), as in KISS-ICP.
+/// Correspondence distance (3 sigma) and kernel scale (sigma / 3), as in KISS-ICP, and the
+/// weight of point-to-point factors.
 struct Thresholds {
   double max_correspondence_m;
   double kernel_scale_m;
-  static Thresholds from_sigma(double sigma_m) { return {3.0 * sigma_m, sigma_m / 3.0}; }
+  double point_to_point_precision = 1.0;  ///< see point_to_point_precision()
+  static Thresholds from_sigma(double sigma_m, double p2p_precision = 1.0) {
+    return {3.0 * sigma_m, sigma_m / 3.0, p2p_precision};
+  }
 };
+
+/// The precision of a point-to-point factor in the units of the GICP factors, whose
+/// covariances are Frobenius-normalised so that a surface's normal variance of about
+/// covariance_epsilon (m^2) counts as 1: epsilon / sigma^2, with sigma from
+/// config.point_to_point_sigma_m or spacing_m / sqrt(12).
+double point_to_point_precision(const RegistrationConfig& config, double covariance_epsilon, double spacing_m);
 
 /// The linear system of `source` at pose T against the map.
 LinearSystem build_linear_system(const SourceCloud& source, const map::MapView& target, const SE3& T,
