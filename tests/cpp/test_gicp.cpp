@@ -117,8 +117,8 @@ TEST(Gicp, PointToPointFallbackWithoutCovariance) {
 }
 
 TEST(Gicp, PointToPointPrecisionFollowsTheSpacing) {
-  RegistrationConfig cfg;  // sigma = spacing / sqrt(12)
-  EXPECT_NEAR(point_to_point_precision(cfg, 1e-3, 0.632), 1e-3 * 12.0 / (0.632 * 0.632), 1e-12);
+  RegistrationConfig cfg;  // sigma = spacing / 2
+  EXPECT_NEAR(point_to_point_precision(cfg, 1e-3, 0.632), 1e-3 * 4.0 / (0.632 * 0.632), 1e-12);
   cfg.point_to_point_sigma_m = std::sqrt(1e-3);  // the paper's weighting
   EXPECT_NEAR(point_to_point_precision(cfg, 1e-3, 0.632), 1.0, 1e-12);
 }

@@ -60,8 +60,8 @@ struct ThresholdConfig {
 struct RegistrationConfig {
   bool sparsity_aware = true;           ///< GICP (true) or plain point-to-point ICP for every point (false)
   /// Points without a covariance (too few neighbours) enter as point-to-point factors whose
-  /// residual has this standard deviation per axis; 0: the map's point spacing / sqrt(12) (a
-  /// point anywhere within one spacing, 18 cm at 4 m voxels). The paper weights them like a
+  /// residual has this standard deviation per axis; 0: half the map's point spacing (the matched
+  /// sample may lie that far away: 32 cm at 4 m voxels). The paper weights them like a
   /// surface's normal (Omega = I, i.e. sqrt(map.covariance_epsilon) = 3.2 cm), which lets a few far
   /// points matched to their own earlier samples pin a scan to a standstill (docs/odometry.md).
   double point_to_point_sigma_m = 0.0;

@@ -40,7 +40,7 @@ std::vector<ConfigField> config_fields(Config& c) {
       {"threshold.max_threshold_m", &c.threshold.max_threshold_m, "cap of sigma"},
       {"registration.sparsity_aware", &c.registration.sparsity_aware, "GICP (true) or point-to-point ICP (false)"},
       {"registration.point_to_point_sigma_m", &c.registration.point_to_point_sigma_m,
-       "residual sigma of points without covariance (point-to-point); 0: map spacing / sqrt(12); paper: 0.0316"},
+       "residual sigma of points without covariance (point-to-point); 0: half the map spacing; paper: 0.0316"},
       {"registration.skip_line_pairs", &c.registration.skip_line_pairs,
        "leave out correspondences whose covariances are both line-like"},
       {"registration.max_iterations", &c.registration.max_iterations, "Gauss-Newton iterations at most"},

@@ -33,9 +33,9 @@ LinearSystem to_system(const Accum& a) {
 }  // namespace
 
 double point_to_point_precision(const RegistrationConfig& config, double covariance_epsilon, double spacing_m) {
-  constexpr double kUniformVariancePerSpacing2 = 1.0 / 12.0;  // variance of a uniform offset over one spacing
-  const double sigma2 = config.point_to_point_sigma_m > 0.0 ? config.point_to_point_sigma_m * config.point_to_point_sigma_m
-                                                            : kUniformVariancePerSpacing2 * spacing_m * spacing_m;
+  constexpr double kSigmaPerSpacing = 0.5;  // the matched sample may lie up to half a spacing away
+  const double sigma_m = config.point_to_point_sigma_m > 0.0 ? config.point_to_point_sigma_m : kSigmaPerSpacing * spacing_m;
+  const double sigma2 = sigma_m * sigma_m;
   return sigma2 > 0.0 ? covariance_epsilon / sigma2 : 1.0;
 }
 

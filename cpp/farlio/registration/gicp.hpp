@@ -46,7 +46,7 @@ struct Thresholds {
 /// The precision of a point-to-point factor in the units of the GICP factors, whose
 /// covariances are Frobenius-normalised so that a surface's normal variance of about
 /// covariance_epsilon (m^2) counts as 1: epsilon / sigma^2, with sigma from
-/// config.point_to_point_sigma_m or spacing_m / sqrt(12).
+/// config.point_to_point_sigma_m or half the spacing.
 double point_to_point_precision(const RegistrationConfig& config, double covariance_epsilon, double spacing_m);
 
 /// The linear system of `source` at pose T against the map.
