@@ -152,3 +152,22 @@ TEST(OnlineOdometry, RealTimeThreadsKeepTheOutputsConsistent) {
   for (std::size_t i = 1; i < samples.size(); ++i) EXPECT_EQ(samples[i].stamp_ns - samples[i - 1].stamp_ns, 10'000'000);
   for (const auto& s : samples) EXPECT_TRUE(s.body_pose.translation().allFinite());
 }
+
+TEST(Replay, ResultsArrivingAfterTheLastImuSampleAreNoImuGap) {
+  // With a large added delay the last results arrive after the recording's IMU ends; that is the
+  // end of the data, not a gap to warn about, and those results are still fused.
+  const Recording& rec = recording();
+  ReplayOptions late;
+  late.latency = LatencyModel::Fixed;
+  late.added_delay_s = 0.3;
+  Odometry replay(Config(), rec.T_imu_lidar, rec.gravity_m_s2, rec.imu, late);
+  int fused = 0;
+  std::int64_t last_output_ns = 0;
+  replay.on_odometry = [&](const OdometrySample& s) { last_output_ns = s.stamp_ns; };
+  for (const auto& s : rec.scans) fused += replay.process(s).fused ? 1 : 0;
+  replay.finish(rec.scans.back().end_stamp_ns + 1'000'000'000);
+  ASSERT_TRUE(replay.fusion_stats().has_value());
+  EXPECT_EQ(replay.fusion_stats()->imu_gaps, 0);
+  EXPECT_GE(fused, 3);
+  EXPECT_LE(last_output_ns, rec.imu.back().stamp_ns);  // no odometry beyond the data
+}

@@ -53,13 +53,16 @@ void Odometry::advance_clock(std::int64_t stamp_ns) {
     while (next_imu_ < imu_.size() && imu_[next_imu_].stamp_ns <= t) fusion_->add_imu(imu_[next_imu_++]);
     fusion_->advance_to(t);
   };
-  while (next_output_ns_ <= stamp_ns) {
+  // The fusion never runs past the recording's last IMU sample: beyond it there is no data, not
+  // a gap (results that arrive later are fused at that time, with their delay compensated).
+  const std::int64_t fusion_until = std::min(stamp_ns, imu_.back().stamp_ns);
+  while (next_output_ns_ <= fusion_until) {
     feed_to(next_output_ns_);
     const auto e = fusion_->estimate();
     if (e.valid && on_odometry) on_odometry({e.stamp_ns, e.pose, e.velocity_body_m_s});
     next_output_ns_ += step_ns;
   }
-  feed_to(stamp_ns);
+  feed_to(fusion_until);
   clock_ns_ = stamp_ns;
 }
 
