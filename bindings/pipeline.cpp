@@ -51,6 +51,12 @@ struct PyOnlineOdometry {
               frames.push_back(f);
             }) {}
   ~PyOnlineOdometry() { odometry.stop(); }  // before the vectors the callbacks fill go away
+  /// Empties one of the collected vectors and returns its contents.
+  template <typename T>
+  std::vector<T> take(std::vector<T>& collected) {
+    std::lock_guard lock(mutex);
+    return std::exchange(collected, {});
+  }
 };
 
 Eigen::MatrixX3f map_points(const map::VoxelMap& m) {
@@ -210,20 +216,10 @@ void bind_pipeline(nb::module_& m) {
           "Blocks until every scan handed over is processed.")
       .def(
           "stop", [](PyOnlineOdometry& o) { o.odometry.stop(); }, nb::call_guard<nb::gil_scoped_release>())
-      .def(
-          "take_odometry",
-          [](PyOnlineOdometry& o) {
-            std::lock_guard lock(o.mutex);
-            return std::exchange(o.samples, {});
-          },
-          "The 10 ms odometry samples since the last call.")
-      .def(
-          "take_frames",
-          [](PyOnlineOdometry& o) {
-            std::lock_guard lock(o.mutex);
-            return std::exchange(o.frames, {});
-          },
-          "What happened to each scan since the last call (processed or dropped, pose, timings).")
+      .def("take_odometry", [](PyOnlineOdometry& o) { return o.take(o.samples); },
+           "The 10 ms odometry samples since the last call.")
+      .def("take_frames", [](PyOnlineOdometry& o) { return o.take(o.frames); },
+           "What happened to each scan since the last call (processed or dropped, pose, timings).")
       .def_prop_ro("inertial", [](PyOnlineOdometry& o) { return o.odometry.inertial(); })
       .def_prop_ro("scans_dropped_busy", [](PyOnlineOdometry& o) { return o.odometry.scans_dropped_busy(); });
 
