@@ -222,8 +222,10 @@ def _json_default(o: Any) -> Any:
 
 def format_summary(s: dict[str, Any]) -> str:
     lat = s["latency_ms"]
+    frac = s["converged_fraction"]
+    converged = "no scan registered yet" if frac is None or math.isnan(frac) else f"{100 * frac:.1f}%"
     lines = [f"{s['mode']}: frames {s['processed']}/{s['frames']} (skipped {s['skipped']}, dropped "
-             f"{s['dropped']}), converged {100 * (s['converged_fraction'] or 0):.1f}%, {s['rate_hz']:.1f} Hz overall",
+             f"{s['dropped']}), converged {converged}, {s['rate_hz']:.1f} Hz overall",
              f"latency per frame: median {lat['median']:.2f} ms, p99 {lat['p99']:.2f} ms, max {lat['max']:.2f} ms"]
     for key, label in (("accuracy", "scan poses"), ("accuracy_odometry", "100 Hz odometry")):
         if s.get(key):
