@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <limits>
 #include <chrono>
 #include <condition_variable>
 #include <mutex>
@@ -25,12 +26,29 @@ struct Recording {
   double gravity_m_s2 = 0;
 };
 
+constexpr double kSeconds = 1.5;  // 15 scans: enough for the LIO to run, short under sanitizers
+constexpr std::size_t kKeepEvery = 4;  // every 4th point (~30k per scan) keeps sanitizer runs short
+
+/// Every k-th point of a scan with its time, intensity and sensor id.
+Scan thinned(const Scan& s, std::size_t k) {
+  Scan out;
+  out.start_stamp_ns = s.start_stamp_ns;
+  out.end_stamp_ns = s.end_stamp_ns;
+  for (std::size_t i = 0; i < s.size(); i += k) {
+    out.points.push_back(s.points[i]);
+    if (!s.time_s.empty()) out.time_s.push_back(s.time_s[i]);
+    if (!s.intensity.empty()) out.intensity.push_back(s.intensity[i]);
+    if (!s.sensor_id.empty()) out.sensor_id.push_back(s.sensor_id[i]);
+  }
+  return out;
+}
+
 Recording urban(double duration_s) {
   sim::SimConfig cfg = sim::default_config(sim::Profile::Urban);
   cfg.duration_s = duration_s;
   const sim::SequenceGenerator gen(cfg);
   Recording r;
-  for (std::size_t i = 0; i < gen.num_scans(); ++i) r.scans.push_back(gen.scan(i));
+  for (std::size_t i = 0; i < gen.num_scans(); ++i) r.scans.push_back(thinned(gen.scan(i), kKeepEvery));
   r.imu = gen.imu();
   r.T_imu_lidar = gen.T_imu_lidar();
   r.gravity_m_s2 = gen.gravity_m_s2();
@@ -38,16 +56,30 @@ Recording urban(double duration_s) {
 }
 
 const Recording& recording() {
-  static const Recording r = urban(2.0);
+  static const Recording r = urban(kSeconds);
   return r;
 }
+
+/// Results that do not depend on how fast this machine is: no registration time budget (a slow
+/// sanitizer build would otherwise drop frames the replay keeps, or the other way round).
+Config deterministic_config() {
+  Config c;
+  c.registration.time_budget_factor = std::numeric_limits<double>::infinity();
+  return c;
+}
+
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+constexpr bool kSanitized = true;  // frames take seconds: real-time pacing cannot keep up
+#else
+constexpr bool kSanitized = false;
+#endif
 
 }  // namespace
 
 TEST(OnlineOdometry, LockstepFromTwoThreadsEqualsTheReplay) {
   const Recording& rec = recording();
-  ASSERT_GE(rec.scans.size(), 15u);
-  const Config config;
+  ASSERT_GE(rec.scans.size(), 12u);
+  const Config config = deterministic_config();
 
   ReplayOptions zero;
   zero.latency = LatencyModel::Zero;
@@ -107,7 +139,7 @@ TEST(OnlineOdometry, LockstepFromTwoThreadsEqualsTheReplay) {
     EXPECT_TRUE(frames[i].processed);
     EXPECT_LT((frames[i].body_pose.translation() - expected_scans[i].translation()).norm(), 1e-6) << "scan " << i;
   }
-  ASSERT_GT(expected.size(), 150u);  // 100 Hz over ~2 s
+  ASSERT_GT(expected.size(), 100u);  // 100 Hz over ~1.5 s
   ASSERT_EQ(got.size(), expected.size());
   for (std::size_t i = 0; i < got.size(); ++i) {
     EXPECT_EQ(got[i].stamp_ns, expected[i].stamp_ns);
@@ -147,8 +179,11 @@ TEST(OnlineOdometry, RealTimeThreadsKeepTheOutputsConsistent) {
   // every scan is reported exactly once; the first is always processed (the worker is idle)
   EXPECT_EQ(processed + dropped, static_cast<int>(rec.scans.size()));
   EXPECT_GE(processed.load(), 1);
-  // the odometry runs on the 10 ms grid without gaps or repeats
-  ASSERT_GT(samples.size(), 10u);
+  // the odometry runs on the 10 ms grid without gaps or repeats (under a sanitizer the first
+  // frame may finish after the last IMU sample, so that nothing is emitted)
+  if (!kSanitized) {
+    ASSERT_GT(samples.size(), 10u);
+  }
   for (std::size_t i = 1; i < samples.size(); ++i) EXPECT_EQ(samples[i].stamp_ns - samples[i - 1].stamp_ns, 10'000'000);
   for (const auto& s : samples) EXPECT_TRUE(s.body_pose.translation().allFinite());
 }
@@ -160,7 +195,7 @@ TEST(Replay, ResultsArrivingAfterTheLastImuSampleAreNoImuGap) {
   ReplayOptions late;
   late.latency = LatencyModel::Fixed;
   late.added_delay_s = 0.3;
-  Odometry replay(Config(), rec.T_imu_lidar, rec.gravity_m_s2, rec.imu, late);
+  Odometry replay(deterministic_config(), rec.T_imu_lidar, rec.gravity_m_s2, rec.imu, late);
   int fused = 0;
   std::int64_t last_output_ns = 0;
   replay.on_odometry = [&](const OdometrySample& s) { last_output_ns = s.stamp_ns; };
