@@ -28,9 +28,9 @@ struct PyOdometry {
   }
 };
 
-Eigen::MatrixX3f map_points(const map::VoxelMap& m) {
+Eigen::MatrixX3f map_points(const pipeline::ScanBackend& b) {
   std::vector<Eigen::Vector3f> pts;
-  m.for_each_point([&](const Eigen::Vector3f& x, const map::Cov3&, bool) { pts.push_back(x); });
+  b.map_snapshot().for_each_point([&](const Eigen::Vector3f& x, const map::Cov3&, bool) { pts.push_back(x); });
   Eigen::MatrixX3f out(static_cast<Eigen::Index>(pts.size()), 3);
   for (std::size_t i = 0; i < pts.size(); ++i) out.row(static_cast<Eigen::Index>(i)) = pts[i].transpose();
   return out;
@@ -161,10 +161,10 @@ void bind_pipeline(nb::module_& m) {
       .def_prop_ro("initial_body_pose", [](const PyOdometry& o) { return o.odometry.initial_body_pose(); })
       .def(
           "map_points",
-[](const PyOdometry& o) { return map_points(o.odometry.scan_pipeline().local_map()); },
+[](const PyOdometry& o) { return map_points(o.odometry.scan_pipeline().backend()); },
           "(N, 3) float32 copy of the submap's points (world frame)")
       .def_prop_ro("map_memory_bytes",
-                   [](const PyOdometry& o) { return o.odometry.scan_pipeline().local_map().memory_bytes(); });
+                   [](const PyOdometry& o) { return o.odometry.scan_pipeline().backend().memory_bytes(); });
 
   nb::class_<pipeline::ScanPipeline>(m, "ScanPipeline",
                                      "preprocess -> sparsity-aware GICP against the adaptive submap -> map update")
@@ -179,9 +179,9 @@ void bind_pipeline(nb::module_& m) {
       .def_prop_ro("frames", &pipeline::ScanPipeline::frames)
       .def(
           "map_points",
-[](const pipeline::ScanPipeline& p) { return map_points(p.local_map()); },
+[](const pipeline::ScanPipeline& p) { return map_points(p.backend()); },
           "(N, 3) float32 copy of the submap's points (world frame)")
-      .def_prop_ro("map_memory_bytes", [](const pipeline::ScanPipeline& p) { return p.local_map().memory_bytes(); });
+      .def_prop_ro("map_memory_bytes", [](const pipeline::ScanPipeline& p) { return p.backend().memory_bytes(); });
 }
 
 }  // namespace farlio::python

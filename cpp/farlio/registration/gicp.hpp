@@ -3,12 +3,14 @@
 // per-point factors of gicp_factor.hpp, correspondences limited to 3 sigma and the Cauchy
 // kernel scale kappa = sigma / 3 (KISS-ICP's adaptive threshold), stopped when |dx| falls below
 // the convergence norm or the time budget runs out. Returns the pose with the linear system.
+#include <functional>
 #include <vector>
 
 #include "farlio/core/config.hpp"
 #include "farlio/core/se3.hpp"
 #include "farlio/exec/cpu_executor.hpp"
 #include "farlio/map/map_view.hpp"
+#include "farlio/registration/gicp_factor.hpp"
 #include "farlio/registration/linear_system.hpp"
 
 namespace farlio::registration {
@@ -39,6 +41,9 @@ struct Thresholds {
   static Thresholds from_sigma(double sigma_m) { return {3.0 * sigma_m, sigma_m / 3.0}; }
 };
 
+/// The per-factor parameters at pose T (what every backend hands the shared factor body).
+FactorParams factor_params(const SE3& T, const Thresholds& th, bool sparsity_aware);
+
 /// The linear system of `source` at pose T against the map.
 LinearSystem build_linear_system(const SourceCloud& source, const map::MapView& target, const SE3& T,
                                  const Thresholds& th, bool sparsity_aware, exec::CpuExecutor& executor);
@@ -46,5 +51,13 @@ LinearSystem build_linear_system(const SourceCloud& source, const map::MapView& 
 RegistrationResult register_scan(const SourceCloud& source, const map::MapView& target, const SE3& initial_guess,
                                  const Thresholds& th, const RegistrationConfig& config, double time_budget_s,
                                  exec::CpuExecutor& executor);
+
+/// Builds the linear system of the source at pose T (a backend's reduction).
+using SystemBuilder = std::function<LinearSystem(const SE3&)>;
+
+/// The Gauss-Newton loop on SE(3), whatever backend builds the systems: stops at convergence,
+/// without inliers, or when the time budget is spent.
+RegistrationResult gauss_newton(const SystemBuilder& build, const SE3& initial_guess, const RegistrationConfig& config,
+                                double time_budget_s);
 
 }  // namespace farlio::registration
