@@ -64,7 +64,8 @@ void bind_pipeline(nb::module_& m) {
       .def_ro("covariance_s", &pipeline::FrameTimings::covariance_s)
       .def_ro("registration_s", &pipeline::FrameTimings::registration_s)
       .def_ro("map_update_s", &pipeline::FrameTimings::map_update_s)
-      .def_ro("total_s", &pipeline::FrameTimings::total_s);
+      .def_ro("total_s", &pipeline::FrameTimings::total_s)
+      .def_ro("device_timed", &pipeline::FrameTimings::device_timed, "stage times from CUDA events");
 
   nb::class_<pipeline::FrameResult>(m, "FrameResult", "What the scan pipeline made of one scan.")
       .def_ro("stamp_ns", &pipeline::FrameResult::stamp_ns)
@@ -164,7 +165,11 @@ void bind_pipeline(nb::module_& m) {
 [](const PyOdometry& o) { return map_points(o.odometry.scan_pipeline().backend()); },
           "(N, 3) float32 copy of the submap's points (world frame)")
       .def_prop_ro("map_memory_bytes",
-                   [](const PyOdometry& o) { return o.odometry.scan_pipeline().backend().memory_bytes(); });
+                   [](const PyOdometry& o) { return o.odometry.scan_pipeline().backend().memory_bytes(); })
+      .def_prop_ro("device", [](const PyOdometry& o) { return device_name(o.odometry.scan_pipeline().backend().device()); },
+                   "'cpu' or 'cuda': the backend the scan pipeline runs on")
+      .def_prop_ro("device_message", [](const PyOdometry& o) { return o.odometry.scan_pipeline().device_message(); },
+                   "why device auto fell back to the CPU ('' when it did not)");
 
   nb::class_<pipeline::ScanPipeline>(m, "ScanPipeline",
                                      "preprocess -> sparsity-aware GICP against the adaptive submap -> map update")
@@ -181,7 +186,11 @@ void bind_pipeline(nb::module_& m) {
           "map_points",
 [](const pipeline::ScanPipeline& p) { return map_points(p.backend()); },
           "(N, 3) float32 copy of the submap's points (world frame)")
-      .def_prop_ro("map_memory_bytes", [](const pipeline::ScanPipeline& p) { return p.backend().memory_bytes(); });
+      .def_prop_ro("map_memory_bytes", [](const pipeline::ScanPipeline& p) { return p.backend().memory_bytes(); })
+      .def_prop_ro("device", [](const pipeline::ScanPipeline& p) { return device_name(p.backend().device()); },
+                   "'cpu' or 'cuda': the backend the stages run on")
+      .def_prop_ro("device_message", &pipeline::ScanPipeline::device_message,
+                   "why device auto fell back to the CPU ('' when it did not)");
 }
 
 }  // namespace farlio::python

@@ -9,8 +9,13 @@ if(NOT FARLIO_CUDA STREQUAL "OFF")
   check_language(CUDA)
   if(CMAKE_CUDA_COMPILER)
     if(NOT DEFINED CMAKE_CUDA_ARCHITECTURES)
-      # Turing, Ampere (incl. A5000), Jetson Orin, Ada, Hopper.
-      set(CMAKE_CUDA_ARCHITECTURES 75 80 86 87 89 90 CACHE STRING "CUDA architectures")
+      if(DEFINED ENV{FARLIO_CUDA_ARCHITECTURES})
+        # a build that only needs to prove the code compiles (CI: scripts/test.sh) picks fewer
+        set(CMAKE_CUDA_ARCHITECTURES "$ENV{FARLIO_CUDA_ARCHITECTURES}" CACHE STRING "CUDA architectures")
+      else()
+        # Turing, Ampere (incl. A5000), Jetson Orin, Ada, Hopper.
+        set(CMAKE_CUDA_ARCHITECTURES 75 80 86 87 89 90 CACHE STRING "CUDA architectures")
+      endif()
     endif()
     enable_language(CUDA)
     # The shared headers need C++20 in CUDA code too. CMake 3.25 knows no CUDA20 dialect for

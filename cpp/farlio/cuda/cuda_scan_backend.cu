@@ -19,6 +19,8 @@ namespace {
 constexpr const char* kScanParameter = "cuda.max_scan_points";
 constexpr const char* kMapParameter = "cuda.max_map_voxels";
 constexpr const char* kFrameMapParameter = "cuda.max_frame_voxels";
+/// Bytes of each buffer of the copy ceiling: well beyond the L2 cache of any card.
+constexpr std::size_t kCopyBytes = std::size_t{256} << 20;
 
 std::size_t checked_size(std::int64_t value, const char* name) {
   if (value <= 0) throw std::invalid_argument(std::string(name) + " must be > 0");
@@ -140,6 +142,7 @@ class CudaScanBackend final : public pipeline::ScanBackend {
     executor_.for_each(frame_size_, [=] __device__(std::size_t i) { world[i] = R * frame[i] + t; });
     const map::InsertStats stats = map_.insert(world_.data(), frame_size_, t, limit);
     *removed_voxels = map_.remove_far(t);
+    last_pose_ = pose;
     timer_.stop(StageTimer::kMapUpdate);
     return stats;
   }
@@ -159,6 +162,21 @@ class CudaScanBackend final : public pipeline::ScanBackend {
     return true;
   }
 
+  std::vector<BandwidthSample> measure_bandwidth(int repeats) {
+    std::vector<BandwidthSample> out{measure_copy(executor_, kCopyBytes, repeats)};
+    const std::size_t n = map_.num_points();
+    DeviceBuffer<Eigen::Vector4f> points(n, "map points");
+    DeviceBuffer<map::Cov3> covs(n, "map points");
+    const std::size_t gathered = map_.gather(points.data(), covs.data(), n, kMapParameter);
+    out.push_back(measure_knn(executor_, map_.view(), points.data(), gathered, config_.map.covariance_neighbors,
+                              map::kUnboundedDistance2, repeats));
+    const auto th = registration::Thresholds::from_sigma(config_.threshold.initial_threshold_m);
+    out.push_back(measure_gicp_reduction(
+        executor_, map_.view(), source_points_.data(), source_covs_.data(), source_size_,
+        static_cast<float>(th.max_correspondence_m * th.max_correspondence_m), last_pose_, repeats));
+    return out;
+  }
+
  private:
   Config config_;
   std::size_t max_points_;
@@ -176,11 +194,18 @@ class CudaScanBackend final : public pipeline::ScanBackend {
   DeviceBuffer<map::Cov3> source_covs_;
   std::size_t frame_size_ = 0;
   std::size_t source_size_ = 0;
+  SE3 last_pose_;  // of the last map update (the bandwidth measurement's GICP pose)
   StageTimer timer_;
 };
 
 std::unique_ptr<pipeline::ScanBackend> make_cuda_scan_backend(const Config& config) {
   return std::make_unique<CudaScanBackend>(config);
+}
+
+std::vector<BandwidthSample> measure_kernel_bandwidth(pipeline::ScanBackend& backend, int repeats) {
+  auto* cuda_backend = dynamic_cast<CudaScanBackend*>(&backend);
+  if (!cuda_backend) throw std::invalid_argument("measure_kernel_bandwidth: the backend is not the CUDA backend");
+  return cuda_backend->measure_bandwidth(repeats);
 }
 
 }  // namespace farlio::cuda

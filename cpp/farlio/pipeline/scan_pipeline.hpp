@@ -61,6 +61,7 @@ class ScanPipeline {
 
   /// The backend that runs the stages (its submap, memory and device).
   [[nodiscard]] const ScanBackend& backend() const { return *backend_; }
+  [[nodiscard]] ScanBackend& backend() { return *backend_; }
   /// Why device auto fell back to the CPU (empty when it did not).
   [[nodiscard]] const std::string& device_message() const { return device_message_; }
   /// The effective parameters (the voxel size is fixed at the first scan when auto).
