@@ -217,14 +217,19 @@ map::InsertStats DeviceVoxelMap::insert(const Eigen::Vector3f* points, std::size
   stats.rejected_full = static_cast<std::size_t>(totals.full);
   stats.covariances_computed = static_cast<std::size_t>(totals.covariances);
 
-  // 4. covariances of the new points (or of every point of a changed voxel)
+  // 4. covariances of the new points (or of every point of a changed voxel): one thread a point
+  //    slot of each group's voxel (the CPU runs the same body in a loop, one task a voxel)
   if (totals.covariances > 0) {
     const int k = config_.covariance_neighbors;
     const auto eps = static_cast<float>(config_.covariance_epsilon);
-    ex.for_each(groups, [=] __device__(std::size_t g) {
+    const auto slots = static_cast<std::size_t>(config_.max_points_per_voxel);
+    ex.for_each(groups * slots, [=] __device__(std::size_t i) {
+      const std::size_t g = i / slots;
+      const auto j = static_cast<std::int32_t>(i % slots);
       const std::int32_t vox = group_voxel[g];
-      if (v.voxel_counts[vox] == first_new[g]) return;
-      map::update_voxel_covariances(v, vox, refresh ? 0 : first_new[g], k, eps);
+      const std::int32_t count = v.voxel_counts[vox];
+      if (count == first_new[g] || j < (refresh ? 0 : first_new[g]) || j >= count) return;
+      map::update_point_covariance(v, vox, j, k, eps);
     });
   }
   return stats;
