@@ -81,6 +81,9 @@ def run_dataset(dataset: Dataset, out_dir: Path, config: Any = None, *, max_fram
     odo = _core.Odometry(config, T_imu_lidar, dataset.gravity_m_s2(), imu, options or replay_options())
     if odo.device_message:
         print(f"farlio: {odo.device_message}", file=sys.stderr)
+    elif odo.device == "cuda":
+        print(f"farlio: CUDA backend, {odo.map_memory_bytes / 2**20:.0f} MiB of device memory preallocated",
+              file=sys.stderr)
     lidar_tum = _core.io.TrajectoryWriter(out_dir / "scans_lidar.tum")
     body_tum = _core.io.TrajectoryWriter(out_dir / "scans_body.tum")
     odom_tum = _core.io.TrajectoryWriter(out_dir / "odometry_body.tum") if odo.inertial else None

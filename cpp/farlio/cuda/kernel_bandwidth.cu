@@ -25,8 +25,8 @@ double median_ms(CudaExecutor& ex, int repeats, const Launch& launch) {
     FARLIO_CUDA_CHECK(cudaEventSynchronize(stop));
     FARLIO_CUDA_CHECK(cudaEventElapsedTime(&m, start, stop));
   }
-  cudaEventDestroy(start);
-  cudaEventDestroy(stop);
+  FARLIO_CUDA_CHECK(cudaEventDestroy(start));
+  FARLIO_CUDA_CHECK(cudaEventDestroy(stop));
   std::nth_element(ms.begin(), ms.begin() + static_cast<std::ptrdiff_t>(ms.size() / 2), ms.end());
   return ms[ms.size() / 2];
 }
