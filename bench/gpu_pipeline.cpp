@@ -131,6 +131,7 @@ void print_bandwidth(pipeline::ScanPipeline& p, int repeats) {
 int main(int argc, char** argv) {
   try {
     const Options o = parse(argc, argv);
+    resolve_device(o.device);  // cuda without a GPU: the error before anything else
     std::printf("%-10s %7s %6s %6s %9s %8s %8s | %8s %8s %8s %8s | %9s %9s | %9s %10s | %7s\n", "profile", "points", "device",
                 "frames", "median ms", "p99 ms", "max ms", "prep", "source", "gicp", "update", "prealloc", "used MiB",
                 "dt_max m", "dr_max deg", "voxels");
