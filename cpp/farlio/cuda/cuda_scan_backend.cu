@@ -10,7 +10,7 @@
 #include "farlio/cuda/map_scratch.hpp"
 #include "farlio/cuda/stage_timer.hpp"
 #include "farlio/map/voxel_update.hpp"
-#include "farlio/pipeline/range_crop.hpp"
+#include "farlio/pipeline/preprocess_point.hpp"
 #include "farlio/registration/factor_sums.hpp"
 
 namespace farlio::cuda {
@@ -77,19 +77,16 @@ class CudaScanBackend final : public pipeline::ScanBackend {
   }
 
   /// Crop, undistortion and the keys of the downsampling cells (one thread a point), then the
-  /// first point of each cell in (cell key, input order): the CPU's voxel_downsample.
+  /// first point of each cell in (cell key, input order), as CpuScanBackend::preprocess.
   std::size_t downsample(std::size_t n, const deskew::ScanMotion& motion, bool undistort) {
-    const pipeline::RangeCrop crop = pipeline::RangeCrop::from(config_.preprocess);
-    const float inv_cell = 1.0f / map_.spacing_m();
+    const pipeline::PreprocessParams pp{pipeline::RangeCrop::from(config_.preprocess), motion, undistort,
+                                        1.0f / map_.spacing_m()};
     const Eigen::Vector3f* raw = raw_.data();
     const float* times = times_.data();
     Eigen::Vector3f* deskewed = deskewed_.data();
     std::uint64_t* keys = scratch_.keys.data();
     executor_.for_each(n, [=] __device__(std::size_t i) {
-      const Eigen::Vector3f p = raw[i];
-      const Eigen::Vector3f q = undistort ? deskew::deskew_point(motion, p, times[i]) : p;
-      deskewed[i] = q;
-      keys[i] = crop.keeps(p) ? map::point_key(q, inv_cell) : map::kEmptyKey;
+      keys[i] = pipeline::preprocess_point(raw[i], undistort ? times[i] : 0.0f, pp, &deskewed[i]);
     });
     std::size_t valid = 0;
     const std::size_t kept = sort_into_groups(scratch_, executor_, algorithms_, n, &valid);

@@ -1,6 +1,7 @@
 #include "farlio/pipeline/cpu_scan_backend.hpp"
 
 #include "farlio/pipeline/preprocess.hpp"
+#include "farlio/pipeline/preprocess_point.hpp"
 
 namespace farlio::pipeline {
 
@@ -17,13 +18,15 @@ void CpuScanBackend::reset(const Config& config) {
 }
 
 std::size_t CpuScanBackend::preprocess(const Scan& scan, const deskew::ScanMotion& motion, bool undistort) {
-  const std::vector<std::int32_t> cropped = crop_by_range(scan.points, config_.preprocess);
-  std::vector<Eigen::Vector3f> points(scan.points.size());
-  executor_.for_each(cropped.size(), [&](std::size_t k) {
-    const auto i = static_cast<std::size_t>(cropped[k]);
-    points[i] = undistort ? deskew::deskew_point(motion, scan.points[i], scan.time_s[i]) : scan.points[i];
+  const PreprocessParams pp{RangeCrop::from(config_.preprocess), motion, undistort, 1.0f / map_.spacing_m()};
+  const std::size_t n = scan.size();
+  std::vector<Eigen::Vector3f> points(n);
+  std::vector<std::pair<std::uint64_t, std::int32_t>> keyed(n);
+  executor_.for_each(n, [&](std::size_t i) {
+    const float tau = undistort ? scan.time_s[i] : 0.0f;
+    keyed[i] = {preprocess_point(scan.points[i], tau, pp, &points[i]), static_cast<std::int32_t>(i)};
   });
-  const std::vector<std::int32_t> kept = voxel_downsample(points, cropped, map_.spacing_m(), executor_);
+  const std::vector<std::int32_t> kept = first_of_each_cell(keyed, executor_);
   frame_.resize(kept.size());
   for (std::size_t k = 0; k < kept.size(); ++k) frame_[k] = points[static_cast<std::size_t>(kept[k])];
   return frame_.size();

@@ -29,11 +29,18 @@ std::vector<std::int32_t> voxel_downsample(const std::vector<Eigen::Vector3f>& p
   executor.for_each(indices.size(), [&](std::size_t i) {
     keyed[i] = {map::point_key(points[static_cast<std::size_t>(indices[i])], inv), static_cast<std::int32_t>(i)};
   });
+  std::vector<std::int32_t> kept = first_of_each_cell(keyed, executor);
+  for (auto& k : kept) k = indices[static_cast<std::size_t>(k)];
+  return kept;
+}
+
+std::vector<std::int32_t> first_of_each_cell(std::vector<std::pair<std::uint64_t, std::int32_t>>& keyed,
+                                             exec::CpuExecutor& executor) {
   executor.run([&] { tbb::parallel_sort(keyed.begin(), keyed.end()); });
   std::vector<std::int32_t> kept;
   for (std::size_t i = 0; i < keyed.size(); ++i) {
     if (keyed[i].first == map::kEmptyKey) break;
-    if (i == 0 || keyed[i].first != keyed[i - 1].first) kept.push_back(indices[static_cast<std::size_t>(keyed[i].second)]);
+    if (i == 0 || keyed[i].first != keyed[i - 1].first) kept.push_back(keyed[i].second);
   }
   return kept;
 }
