@@ -114,7 +114,7 @@ void BM_GicpIteration(benchmark::State& state) {
   const auto src = registration::source_from_map(frame.view(), frame.voxel_capacity());
   const auto th = registration::Thresholds::from_sigma(1.0);
   for (auto _ : state) {
-    benchmark::DoNotOptimize(registration::build_linear_system(src, f.map.view(), SE3(), th, true, f.ex));
+    benchmark::DoNotOptimize(registration::build_linear_system(src, f.map.view(), SE3(), th, RegistrationConfig(), f.ex));
   }
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(src.size()));
 }

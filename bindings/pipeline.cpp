@@ -6,9 +6,13 @@
 #include <nanobind/stl/vector.h>
 #include <nanobind/stl/pair.h>
 
+#include <mutex>
+#include <utility>
+
 #include "bindings.hpp"
 #include "farlio/core/config_fields.hpp"
 #include "farlio/pipeline/odometry.hpp"
+#include "farlio/pipeline/online_odometry.hpp"
 #include "farlio/pipeline/pairwise.hpp"
 #include "farlio/pipeline/scan_pipeline.hpp"
 
@@ -25,6 +29,33 @@ struct PyOdometry {
   PyOdometry(const Config& c, const SE3& T, double g, std::vector<ImuSample> imu, const pipeline::ReplayOptions& o)
       : odometry(c, T, g, std::move(imu), o) {
     odometry.on_odometry = [this](const pipeline::OdometrySample& s) { pending.push_back(s); };
+  }
+};
+
+/// The online odometry with its outputs collected for polling: the worker thread never calls
+/// into Python (and so never needs the GIL).
+struct PyOnlineOdometry {
+  std::mutex mutex;
+  std::vector<pipeline::OdometrySample> samples;
+  std::vector<pipeline::OdometryFrame> frames;
+  pipeline::OnlineOdometry odometry;
+  PyOnlineOdometry(const Config& c, const SE3& T, double g)
+      : odometry(
+            c, T, g,
+            [this](const pipeline::OdometrySample& s) {
+              std::lock_guard lock(mutex);
+              samples.push_back(s);
+            },
+            [this](const pipeline::OdometryFrame& f) {
+              std::lock_guard lock(mutex);
+              frames.push_back(f);
+            }) {}
+  ~PyOnlineOdometry() { odometry.stop(); }  // before the vectors the callbacks fill go away
+  /// Empties one of the collected vectors and returns its contents.
+  template <typename T>
+  std::vector<T> take(std::vector<T>& collected) {
+    std::lock_guard lock(mutex);
+    return std::exchange(collected, {});
   }
 };
 
@@ -170,6 +201,32 @@ void bind_pipeline(nb::module_& m) {
                    "'cpu' or 'cuda': the backend the scan pipeline runs on")
       .def_prop_ro("device_message", [](const PyOdometry& o) { return o.odometry.scan_pipeline().device_message(); },
                    "why device auto fell back to the CPU ('' when it did not)");
+
+  nb::class_<pipeline::OdometrySample>(m, "OdometrySample", "One 10 ms sample of the fused odometry.")
+      .def_ro("stamp_ns", &pipeline::OdometrySample::stamp_ns)
+      .def_ro("body_pose", &pipeline::OdometrySample::body_pose)
+      .def_ro("velocity_body_m_s", &pipeline::OdometrySample::velocity_body_m_s);
+  nb::class_<PyOnlineOdometry>(m, "OnlineOdometry",
+                               "LIO for live data: push IMU samples and scans as they arrive (any thread); the scan "
+                               "pipeline runs on a worker; poll the 100 Hz odometry and the per-scan frames.")
+      .def(nb::init<const Config&, const SE3&, double>(), "config"_a, "T_imu_lidar"_a, "gravity_m_s2"_a = 9.81)
+      .def(
+          "add_imu", [](PyOnlineOdometry& o, const ImuSample& s) { o.odometry.add_imu(s); }, "sample"_a,
+          nb::call_guard<nb::gil_scoped_release>())
+      .def(
+          "add_scan", [](PyOnlineOdometry& o, const Scan& s) { return o.odometry.add_scan(s); }, "scan"_a,
+          nb::call_guard<nb::gil_scoped_release>(), "False when dropped because the worker was busy.")
+      .def(
+          "wait_idle", [](PyOnlineOdometry& o) { o.odometry.wait_idle(); }, nb::call_guard<nb::gil_scoped_release>(),
+          "Blocks until every scan handed over is processed.")
+      .def(
+          "stop", [](PyOnlineOdometry& o) { o.odometry.stop(); }, nb::call_guard<nb::gil_scoped_release>())
+      .def("take_odometry", [](PyOnlineOdometry& o) { return o.take(o.samples); },
+           "The 10 ms odometry samples since the last call.")
+      .def("take_frames", [](PyOnlineOdometry& o) { return o.take(o.frames); },
+           "What happened to each scan since the last call (processed or dropped, pose, timings).")
+      .def_prop_ro("inertial", [](PyOnlineOdometry& o) { return o.odometry.inertial(); })
+      .def_prop_ro("scans_dropped_busy", [](PyOnlineOdometry& o) { return o.odometry.scans_dropped_busy(); });
 
   nb::class_<pipeline::ScanPipeline>(m, "ScanPipeline",
                                      "preprocess -> sparsity-aware GICP against the adaptive submap -> map update")

@@ -31,3 +31,7 @@ fi
 .venv/bin/python -m pip install -q --upgrade pip
 # Build backend and test tools (versions pinned to what the project is tested with).
 .venv/bin/python -m pip install -q -r scripts/requirements-dev.txt
+# ouster-sdk 1.0.1 pins rosbags==0.9.23, which evo (rosbags>=0.11.1) excludes, and flask/nanobind
+# versions; farlio uses only its packet decoding (ouster.sdk.core, ouster.sdk.pcap), which needs
+# numpy, more-itertools and rosbags at import: install it without its pins.
+.venv/bin/python -m pip install -q --no-deps ouster-sdk==1.0.1

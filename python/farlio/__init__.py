@@ -6,12 +6,17 @@ from __future__ import annotations
 
 from ._core import (  # noqa: F401
     SE3,
+    Config,
     ImuSample,
     InputError,
+    Odometry,
+    OnlineOdometry,
     Scan,
+    ScanPipeline,
     Trajectory,
     cuda_compiled,
     cuda_device_count,
+    register_pair,
 )
 from ._core import eval as _eval_ext  # noqa: F401
 from ._core import io  # noqa: F401

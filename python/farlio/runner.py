@@ -11,6 +11,7 @@ Outputs in the output folder (every trajectory file names its frame):
   config.yaml            the full effective parameter set
   eval_scans/, eval_odometry/   eval.json + eval.png against the ground truth, when there is one
   map.ply                the final submap (with --save-map)
+  trajectory.png, latency.png   the estimated path (with ground truth) and the latency histogram (with plot)
 """
 from __future__ import annotations
 
@@ -20,7 +21,7 @@ import math
 import sys
 import time
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -65,8 +66,12 @@ def replay_options(latency: str = "measured", fixed_latency_s: float = 0.0, adde
 
 def run_dataset(dataset: Dataset, out_dir: Path, config: Any = None, *, max_frames: int | None = None,
                 save_map: bool = False, groundtruth: Path | None = None, progress: bool | None = None,
-                plot: bool = True, options: Any = None) -> dict[str, Any]:
-    """Runs the odometry over `dataset` and writes the outputs listed in the module doc."""
+                plot: bool = True, options: Any = None, use_imu: bool = True,
+                on_frame: Callable[[int, Any, Any], None] | None = None) -> dict[str, Any]:
+    """Runs the odometry over `dataset` and writes the outputs listed in the module doc.
+
+    use_imu False runs LiDAR-only even when the recording has an IMU; on_frame(i, scan, frame
+    result) is called after every processed scan (a live view)."""
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     config = config or _core.Config()
@@ -77,7 +82,7 @@ def run_dataset(dataset: Dataset, out_dir: Path, config: Any = None, *, max_fram
         _warn(w)
 
     T_imu_lidar = dataset.T_imu_lidar()
-    imu = dataset.imu()
+    imu = dataset.imu() if use_imu else []
     odo = _core.Odometry(config, T_imu_lidar, dataset.gravity_m_s2(), imu, options or replay_options())
     if odo.device_message:
         print(f"farlio: {odo.device_message}", file=sys.stderr)
@@ -138,6 +143,8 @@ def run_dataset(dataset: Dataset, out_dir: Path, config: Any = None, *, max_fram
                                                              t.map_update_s, t.total_s)] +
                             [STAGE_CLOCKS[t.device_timed], int(fr.fused), int(fr.guess_from_fusion),
                              f"{(fr.available_ns - fr.started_ns) / 1e6:.3f}", fr.drop_reason])
+            if on_frame is not None:
+                on_frame(i, scan, fr)
             bar.update(i + 1, f"{t.total_s * MS_PER_S:6.1f} ms")
         if last_stamp is not None:
             odo.finish(last_stamp)
@@ -188,6 +195,9 @@ def run_dataset(dataset: Dataset, out_dir: Path, config: Any = None, *, max_fram
             _warn(f"{stats.imu_gaps} IMU gap(s): no sample for longer than fusion.imu_gap_limit_s "
                   "(the last input was held)")
     _evaluate(summary, dataset, out_dir, groundtruth, plot, len(lidar_traj))
+    if plot and totals_ms:
+        from .plots import plot_run
+        plot_run(out_dir, summary.get("accuracy", {}).get("groundtruth_file"))
     (out_dir / "config.yaml").write_text(config_to_yaml(odo.effective_config))
     summary["voxel_size_m"] = float(odo.effective_config.get("map.voxel_size_m"))
     (out_dir / "summary.json").write_text(json.dumps(summary, indent=2, default=_json_default))
@@ -202,6 +212,8 @@ def _evaluate(summary: dict[str, Any], dataset: Dataset, out_dir: Path, groundtr
     gt_scans = groundtruth
     if gt_scans is None and (Path(dataset.path) / "groundtruth_scans.tum").exists():
         gt_scans = Path(dataset.path) / "groundtruth_scans.tum"
+    if gt_scans is None:
+        gt_scans = dataset.groundtruth()  # a dense ground truth (MulRan): interpolated at the scan stamps
     if gt_scans is not None:
         summary["accuracy"] = evaluate_files(out_dir / "scans_body.tum", Path(gt_scans), out_dir / "eval_scans",
                                              plot=plot)
@@ -221,8 +233,10 @@ def _json_default(o: Any) -> Any:
 
 def format_summary(s: dict[str, Any]) -> str:
     lat = s["latency_ms"]
+    frac = s["converged_fraction"]
+    converged = "no scan registered yet" if frac is None or math.isnan(frac) else f"{100 * frac:.1f}%"
     lines = [f"{s['mode']}: frames {s['processed']}/{s['frames']} (skipped {s['skipped']}, dropped "
-             f"{s['dropped']}), converged {100 * (s['converged_fraction'] or 0):.1f}%, {s['rate_hz']:.1f} Hz overall",
+             f"{s['dropped']}), converged {converged}, {s['rate_hz']:.1f} Hz overall",
              f"latency per frame: median {lat['median']:.2f} ms, p99 {lat['p99']:.2f} ms, max {lat['max']:.2f} ms"]
     for key, label in (("accuracy", "scan poses"), ("accuracy_odometry", "100 Hz odometry")):
         if s.get(key):

@@ -84,7 +84,8 @@ INSTANTIATE_TEST_SUITE_P(Perturbations, GicpRecovers,
                                            std::make_tuple(0.0, 5.0), std::make_tuple(0.5, 5.0)));
 
 TEST(Gicp, PointToPointFallbackWithoutCovariance) {
-  // A source point without a covariance is weighted by Omega = I (Sigma_r = I, Sigma_s = 0).
+  // A source point without a covariance is weighted by Omega = lambda I (Sigma_s = 0): the
+  // paper's lambda = 1 here.
   exec::CpuExecutor ex(1);
   map::VoxelMap target(VoxelMapConfig{}, ex);
   target.insert(test::sample_scene(60000, 3), Eigen::Vector3f::Zero(), map::PointLimit::constant(40));
@@ -105,19 +106,70 @@ TEST(Gicp, PointToPointFallbackWithoutCovariance) {
   FactorTerms f_off{};
   ASSERT_TRUE(gicp_factor(target.view(), with_cov, c, fp, f_off));
   for (int k = 0; k < 21; ++k) EXPECT_FLOAT_EQ(f_off.H[k], f_p2p.H[k]);
+  // farlio's lambda scales the point-to-point information and nothing else
+  fp.sparsity_aware = true;
+  fp.point_to_point_precision = 0.03f;
+  FactorTerms f_scaled{}, f_cov_again{};
+  ASSERT_TRUE(gicp_factor(target.view(), without, c, fp, f_scaled));
+  ASSERT_TRUE(gicp_factor(target.view(), with_cov, c, fp, f_cov_again));
+  for (int k = 0; k < 21; ++k) EXPECT_NEAR(f_scaled.H[k], 0.03f * f_p2p.H[k], 1e-5f * (1.0f + std::abs(f_p2p.H[k])));
+  for (int k = 0; k < 21; ++k) EXPECT_FLOAT_EQ(f_cov_again.H[k], f_cov.H[k]);
 }
 
-TEST(Gicp, SparseSourceStillRegisters) {
-  // Isolated floor points have fewer than k neighbours, so they get no covariance.
+TEST(Gicp, PointToPointPrecisionFollowsTheSpacing) {
+  RegistrationConfig cfg;  // sigma = spacing / 2
+  EXPECT_NEAR(point_to_point_precision(cfg, 1e-3, 0.632), 1e-3 * 4.0 / (0.632 * 0.632), 1e-12);
+  cfg.point_to_point_sigma_m = std::sqrt(1e-3);  // the paper's weighting
+  EXPECT_NEAR(point_to_point_precision(cfg, 1e-3, 0.632), 1.0, 1e-12);
+}
+
+class SparseSource : public ::testing::TestWithParam<bool> {};
+
+TEST_P(SparseSource, StillRegisters) {
+  // Isolated floor points have fewer than k neighbours, so they get no covariance; the scan
+  // registers with farlio's defaults (point-to-point factors weighted by the spacing, line
+  // pairs left out) and with the paper's (Omega = I, line pairs kept).
   Problem pb(make_pose(0.5, 0.2, 0.0, 3.0), true);
   std::size_t without = 0;
-  for (const auto& p : pb.source.points) without += p.w() > 0 ? 0 : 1;
+  for (const auto& p : pb.source.points) without += map::has_covariance(p) ? 0 : 1;
   EXPECT_GE(without, 20u) << "the fallback must be exercised";
   const SE3 guess = pb.truth * make_pose(0.3, -0.2, 0.1, 2.0);
-  const auto res = register_scan(pb.source, pb.target.view(), guess, Thresholds::from_sigma(1.0), RegistrationConfig{},
-                                 kNoBudget, pb.ex);
+  RegistrationConfig cfg;
+  const bool paper = GetParam();
+  cfg.skip_line_pairs = !paper;
+  const double spacing_m = 0.632;
+  const auto th = Thresholds::from_sigma(1.0, paper ? 1.0 : point_to_point_precision(cfg, 1e-3, spacing_m));
+  const auto res = register_scan(pb.source, pb.target.view(), guess, th, cfg, kNoBudget, pb.ex);
   EXPECT_LT(trans_err(res.pose, pb.truth), 0.05);
   EXPECT_LT(rot_err_deg(res.pose, pb.truth), 0.2);
+}
+
+INSTANTIATE_TEST_SUITE_P(PaperWeighting, SparseSource, ::testing::Bool());
+
+TEST(Gicp, PairsOfLineLikeCovariancesAreLeftOut) {
+  // A map holding one line along y (a scan line on the ground seen from one place). A line-like
+  // source point matched to it gives no factor with skip_line_pairs; a surface-like one does.
+  exec::CpuExecutor ex(1);
+  std::vector<Eigen::Vector3f> lines;
+  for (int j = 0; j < 40; ++j) lines.emplace_back(10.0f, -6.0f + 0.3f * static_cast<float>(j), 0.0f);
+  map::VoxelMap target(VoxelMapConfig{}, ex);
+  target.insert(lines, Eigen::Vector3f::Zero(), map::PointLimit::constant(40));
+  std::size_t line_like = 0, valid_covs = 0;
+  target.for_each_point([&](const Eigen::Vector3f&, const map::Cov3& c, bool valid) {
+    valid_covs += valid ? 1 : 0;
+    line_like += valid && map::classify_shape(c.matrix(), 10.0f) == map::PointShape::Line ? 1 : 0;
+  });
+  EXPECT_GE(valid_covs, 8u);
+  EXPECT_EQ(line_like, valid_covs) << "every covariance of a lone line is line-like";
+  FactorParams fp{Eigen::Matrix3f::Identity(), Eigen::Vector3f(0.1f, 0.0f, 0.0f), 4.0f, CauchyKernel{1.0f}, true};
+  const map::Cov3 c = map::Cov3::from(Eigen::Matrix3f::Identity());
+  const Eigen::Vector4f line_src(10.0f, 0.0f, 0.0f, map::shape_code(map::PointShape::Line));
+  const Eigen::Vector4f surface_src(10.0f, 0.0f, 0.0f, map::shape_code(map::PointShape::Surface));
+  FactorTerms f{};
+  EXPECT_FALSE(gicp_factor(target.view(), line_src, c, fp, f));
+  EXPECT_TRUE(gicp_factor(target.view(), surface_src, c, fp, f));
+  fp.skip_line_pairs = false;
+  EXPECT_TRUE(gicp_factor(target.view(), line_src, c, fp, f));
 }
 
 TEST(Gicp, TimeBudgetStopsIt) {

@@ -73,9 +73,9 @@ TEST(SharedBodies, FactorSumsReduceToTheSameSystemAsPerPointSums) {
   }
   const auto th = registration::Thresholds::from_sigma(1.0);
   const SE3 T;
-  const auto sys = registration::build_linear_system(src, target.view(), T, th, true, ex);
+  const auto sys = registration::build_linear_system(src, target.view(), T, th, RegistrationConfig{}, ex);
   // serial sum of the same per-point bodies
-  const auto fp = registration::factor_params(T, th, true);
+  const auto fp = registration::factor_params(T, th, RegistrationConfig{});
   auto serial = registration::FactorSums::zero();
   for (std::size_t i = 0; i < src.size(); ++i) serial += registration::factor_sums(target.view(), src.points[i], src.covs[i], fp);
   const auto ref = registration::to_linear_system(serial);

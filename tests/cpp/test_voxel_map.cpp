@@ -221,8 +221,40 @@ TEST(VoxelMap, CovarianceOfAPlaneIsFlat) {
     EXPECT_GT(std::abs(normal.z()), 0.99f);                // smallest axis is the plane normal
     EXPECT_LT(es.eigenvalues()(0) / es.eigenvalues()(2), 0.05f);
     EXPECT_NEAR(c.matrix().inverse().norm(), 1.0f, 1e-3f);  // Frobenius normalisation: ||Sigma^-1||_F = 1
+    EXPECT_EQ(classify_shape(c.matrix(), 10.0f), PointShape::Surface);
   });
   EXPECT_GT(valid, m.num_points() * 9 / 10);
+}
+
+TEST(Covariance, ClosedFormEigenvaluesEqualEigensSolver) {
+  std::mt19937 rng(3);
+  std::normal_distribution<float> g(0.0f, 1.0f);
+  for (int trial = 0; trial < 500; ++trial) {
+    Eigen::Matrix3f a;
+    for (int i = 0; i < 9; ++i) a.data()[i] = g(rng);
+    // spread the scales as regularised covariances have them (1 to 1e3)
+    const Eigen::Vector3f scale(1.0f, std::exp(3.0f * std::abs(g(rng))), std::exp(4.0f * std::abs(g(rng))));
+    const Eigen::Matrix3f q = a.householderQr().householderQ();
+    const Eigen::Matrix3f m = q * scale.asDiagonal() * q.transpose();
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(m.cast<double>());
+    const Eigen::Vector3f ours = symmetric_eigenvalues(m);
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(ours(k), es.eigenvalues()(k), 1e-4 * es.eigenvalues()(2)) << m;
+  }
+  EXPECT_TRUE(symmetric_eigenvalues(2.0f * Eigen::Matrix3f::Identity()).isApproxToConstant(2.0f));
+}
+
+TEST(Covariance, ShapeOfLinesAndPlanes) {
+  const float eps = 1e-3f;
+  Eigen::Matrix3f line = Eigen::Matrix3f::Zero(), plane = Eigen::Matrix3f::Zero();
+  line(1, 1) = 1.0f;                     // 1 m spread along y, nothing across
+  plane(0, 0) = plane(1, 1) = 0.5f;      // a plane z = const
+  EXPECT_EQ(classify_shape(regularize_frobenius(line, eps), 10.0f), PointShape::Line);
+  EXPECT_EQ(classify_shape(regularize_frobenius(plane, eps), 10.0f), PointShape::Surface);
+  EXPECT_EQ(classify_shape(regularize_frobenius(line, eps), 0.0f), PointShape::Surface);  // classification off
+  // a "line" 10 cm wide is a surface strip at the default ratio
+  Eigen::Matrix3f strip = line;
+  strip(0, 0) = 0.01f;
+  EXPECT_EQ(classify_shape(regularize_frobenius(strip, eps), 10.0f), PointShape::Surface);
 }
 
 TEST(HashTable, LinearProbingSurvivesCollisionsAndErasure) {

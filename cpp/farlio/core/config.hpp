@@ -30,6 +30,10 @@ struct VoxelMapConfig {
   double point_spacing_m = 0.0;
   int covariance_neighbors = 10;       ///< k nearest neighbours for a point covariance (paper: 10)
   double covariance_epsilon = 1e-3;    ///< C = Sigma_hat + eps * I before Frobenius normalisation (eq. 1)
+  /// A covariance is line-like when, after regularisation, its middle eigenvalue is below this
+  /// ratio times the smallest while the largest is above it (points along one scan line or a
+  /// pole). 0: never classify (every covariance counts as a surface).
+  double line_eigenvalue_ratio = 10.0;
   double removal_radius_m = 1000.0;    ///< voxels whose centre is farther from the pose are removed
   /// Recompute the covariances of existing points in voxels that received new points (the
   /// reference never refreshes them).
@@ -56,7 +60,16 @@ struct ThresholdConfig {
 
 /// Sparsity-aware GICP (scan to submap).
 struct RegistrationConfig {
-  bool sparsity_aware = true;           ///< GICP with point-to-point fallback; false: point-to-point only
+  bool sparsity_aware = true;           ///< GICP (true) or plain point-to-point ICP for every point (false)
+  /// Points without a covariance (too few neighbours) enter as point-to-point factors whose
+  /// residual has this standard deviation per axis; 0: half the map's point spacing (the matched
+  /// sample may lie that far away: 32 cm at 4 m voxels). The paper weights them like a
+  /// surface's normal (Omega = I, i.e. sqrt(map.covariance_epsilon) = 3.2 cm), which lets a few far
+  /// points matched to their own earlier samples pin a scan to a standstill (docs/odometry.md).
+  double point_to_point_sigma_m = 0.0;
+  /// Leave out correspondences whose two covariances are both line-like (map.line_eigenvalue_ratio):
+  /// two scan lines recorded from the same place fake a constraint across the line.
+  bool skip_line_pairs = true;
   int max_iterations = 500;
   double convergence_norm = 5e-3;       ///< stop when |dx| (6-vector, m and rad) falls below this
   double time_budget_factor = 2.0;      ///< time budget = factor * LiDAR period (paper: 2)

@@ -112,14 +112,15 @@ class CudaScanBackend final : public pipeline::ScanBackend {
                                                    const RegistrationConfig& config, double time_budget_s) override {
     timer_.start(StageTimer::kRegistration);
     const auto result = registration::gauss_newton(
-        [&](const SE3& T) { return linear_system(T, th, config.sparsity_aware); }, initial_guess, config, time_budget_s);
+        [&](const SE3& T) { return linear_system(T, th, config); }, initial_guess, config, time_budget_s);
     timer_.stop(StageTimer::kRegistration);
     return result;
   }
 
   /// One Gauss-Newton system: the shared factor body per source point, reduced with CUB.
-  registration::LinearSystem linear_system(const SE3& T, const registration::Thresholds& th, bool sparsity_aware) {
-    const registration::FactorParams fp = registration::factor_params(T, th, sparsity_aware);
+  registration::LinearSystem linear_system(const SE3& T, const registration::Thresholds& th,
+                                           const RegistrationConfig& config) {
+    const registration::FactorParams fp = registration::factor_params(T, th, config);
     const map::MapView target = map_.view();
     const Eigen::Vector4f* points = source_points_.data();
     const map::Cov3* covs = source_covs_.data();

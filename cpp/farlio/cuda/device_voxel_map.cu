@@ -222,6 +222,7 @@ map::InsertStats DeviceVoxelMap::insert(const Eigen::Vector3f* points, std::size
   if (totals.covariances > 0) {
     const int k = config_.covariance_neighbors;
     const auto eps = static_cast<float>(config_.covariance_epsilon);
+    const auto line_ratio = static_cast<float>(config_.line_eigenvalue_ratio);
     const auto slots = static_cast<std::size_t>(config_.max_points_per_voxel);
     ex.for_each(groups * slots, [=] __device__(std::size_t i) {
       const std::size_t g = i / slots;
@@ -229,7 +230,7 @@ map::InsertStats DeviceVoxelMap::insert(const Eigen::Vector3f* points, std::size
       const std::int32_t vox = group_voxel[g];
       const std::int32_t count = v.voxel_counts[vox];
       if (count == first_new[g] || j < (refresh ? 0 : first_new[g]) || j >= count) return;
-      map::update_point_covariance(v, vox, j, k, eps);
+      map::update_point_covariance(v, vox, j, k, eps, line_ratio);
     });
   }
   return stats;

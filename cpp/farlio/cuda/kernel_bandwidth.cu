@@ -107,7 +107,7 @@ BandwidthSample measure_knn(CudaExecutor& ex, const map::MapView& m, const Eigen
 BandwidthSample measure_gicp_reduction(CudaExecutor& ex, const map::MapView& m, const Eigen::Vector4f* points,
                                        const map::Cov3* covs, std::size_t n, float max_distance2, const SE3& pose,
                                        int repeats) {
-  registration::FactorParams fp = registration::factor_params(pose, registration::Thresholds::from_sigma(1.0), true);
+  registration::FactorParams fp = registration::factor_params(pose, registration::Thresholds::from_sigma(1.0), RegistrationConfig{});
   fp.max_correspondence_distance2 = max_distance2;
   BandwidthSample s{"GICP reduction", 0.0, search_bytes(ex, m, points, n, max_distance2, fp.R, fp.t)};
   s.bytes += static_cast<double>(n * sizeof(map::Cov3));

@@ -18,14 +18,14 @@ struct MapSnapshot {
   std::vector<Eigen::Vector4f> points;  ///< voxel v's j-th point at v * max_points_per_voxel + j
   std::vector<Cov3> covs;
 
-  /// Calls f(point, covariance, covariance_valid) for every stored point, in pool order.
+  /// Calls f(point, covariance, has_covariance) for every stored point, in pool order.
   template <typename F>
   void for_each_point(const F& f) const {
     const auto n = static_cast<std::size_t>(max_points_per_voxel);
     for (std::size_t v = 0; v < voxel_keys.size(); ++v) {
       for (std::size_t j = 0; j < static_cast<std::size_t>(voxel_counts[v]); ++j) {
         const Eigen::Vector4f& p = points[v * n + j];
-        f(Eigen::Vector3f(p.head<3>()), covs[v * n + j], p.w() > 0.0f);
+        f(Eigen::Vector3f(p.head<3>()), covs[v * n + j], has_covariance(p));
       }
     }
   }

@@ -6,7 +6,7 @@
 // Table: open addressing with linear probing (step 1) over `table_capacity` slots (a power of
 // two); slot_keys[s] is a packed voxel key, kEmptyKey or kErasedKey; slot_voxels[s] is the
 // voxel's index in the pool. Pool: voxel v holds voxel_counts[v] points at
-// points[v * max_points_per_voxel + j]; point.w() is 1 when its covariance covs[...] is valid.
+// points[v * max_points_per_voxel + j]; point.w() is its PointShape (covariance.hpp): 0 without a valid covariance in covs[...].
 #include <Eigen/Core>
 #include <cstdint>
 

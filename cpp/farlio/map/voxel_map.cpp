@@ -188,7 +188,9 @@ void VoxelMap::compute_covariances(const std::vector<std::int32_t>& voxels, cons
   const MapView v = view();
   const int k = config_.covariance_neighbors;
   const auto eps = static_cast<float>(config_.covariance_epsilon);
-  executor_->for_each(voxels.size(), [&](std::size_t i) { update_voxel_covariances(v, voxels[i], first_point[i], k, eps); });
+  const auto line_ratio = static_cast<float>(config_.line_eigenvalue_ratio);
+  executor_->for_each(voxels.size(),
+                      [&](std::size_t i) { update_voxel_covariances(v, voxels[i], first_point[i], k, eps, line_ratio); });
 }
 
 std::size_t VoxelMap::remove_far(const Eigen::Vector3f& origin) {

@@ -74,29 +74,32 @@ FARLIO_HD GroupStats insert_voxel_group(const MapView& m, std::int32_t voxel, co
 /// No distance limit for the covariance neighbours (the 27 voxels bound them).
 inline constexpr float kUnboundedDistance2 = std::numeric_limits<float>::max();
 
-/// Covariance (eq. 1) of point j of `voxel` from its k nearest neighbours; a point with fewer
-/// than k neighbours is marked invalid (w = 0). Reads the points of the 27 voxels around it.
-FARLIO_HD inline void update_point_covariance(const MapView& m, std::int32_t voxel, std::int32_t j, int k, float epsilon) {
+/// Covariance (eq. 1) of point j of `voxel` from its k nearest neighbours, and its shape in w
+/// (map::PointShape: no covariance with fewer than k neighbours, else surface or line by
+/// `line_ratio`). Reads the points of the 27 voxels around it.
+FARLIO_HD inline void update_point_covariance(const MapView& m, std::int32_t voxel, std::int32_t j, int k, float epsilon,
+                                              float line_ratio) {
   std::int64_t idx[kMaxNeighbors];
   float d2[kMaxNeighbors];
   const std::int64_t pi = m.point_index(voxel, j);
   const Eigen::Vector3f p = m.points[pi].head<3>();
   const int found = knn_search(m, p, k, kUnboundedDistance2, idx, d2);
   if (found < k) {
-    m.points[pi].w() = 0.0f;
+    m.points[pi].w() = shape_code(PointShape::NoCovariance);
     return;
   }
   CovarianceAccumulator acc(p);
   for (int n = 0; n < found; ++n) acc.add(m.points[idx[n]].head<3>());
-  m.covs[pi] = Cov3::from(regularize_frobenius(acc.covariance(), epsilon));
-  m.points[pi].w() = 1.0f;
+  const Eigen::Matrix3f cov = regularize_frobenius(acc.covariance(), epsilon);
+  m.covs[pi] = Cov3::from(cov);
+  m.points[pi].w() = shape_code(classify_shape(cov, line_ratio));
 }
 
 /// Covariances of the points [first, count) of `voxel` (one CPU task a voxel).
 FARLIO_HD inline void update_voxel_covariances(const MapView& m, std::int32_t voxel, std::int32_t first, int k,
-                                               float epsilon) {
+                                               float epsilon, float line_ratio) {
   const std::int32_t count = m.voxel_counts[voxel];
-  for (std::int32_t j = first; j < count; ++j) update_point_covariance(m, voxel, j, k, epsilon);
+  for (std::int32_t j = first; j < count; ++j) update_point_covariance(m, voxel, j, k, epsilon, line_ratio);
 }
 
 /// Squared distance (double) from `origin` to the centre of the voxel with this key.

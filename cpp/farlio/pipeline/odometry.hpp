@@ -70,12 +70,12 @@ class Odometry {
   [[nodiscard]] bool inertial() const { return fusion_.has_value(); }
   [[nodiscard]] const ScanPipeline& scan_pipeline() const { return pipeline_; }
   [[nodiscard]] std::optional<fusion::FusionStats> fusion_stats() const;
-  /// The body pose the world frame starts from (roll and pitch from gravity when inertial).
+  /// The body pose the world frame starts from (roll and pitch from gravity when inertial, set
+  /// at the first scan from the IMU samples up to its end).
   [[nodiscard]] const SE3& initial_body_pose() const { return initial_body_pose_; }
 
  private:
   void advance_clock(std::int64_t stamp_ns);
-  std::optional<deskew::ScanMotion> motion_from_fusion(const Scan& scan, const SE3& end_pose) const;
   [[nodiscard]] double latency_s(const FrameResult& r) const;
 
   Config config_;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <stdexcept>
 
 #include "farlio/pipeline/preprocess.hpp"
 
@@ -25,6 +26,11 @@ ScanPipeline::ScanPipeline(const Config& config, const SE3& initial_pose)
       initial_pose_(initial_pose),
       last_pose_(initial_pose),
       prev_pose_(initial_pose) {}
+
+void ScanPipeline::reset_initial_pose(const SE3& initial_pose) {
+  if (frames_ > 0) throw std::logic_error("ScanPipeline::reset_initial_pose after the first scan");
+  initial_pose_ = last_pose_ = prev_pose_ = initial_pose;
+}
 
 registration::Vec6d ScanPipeline::last_twist() const {
   if (frames_ < 2 || last_stamp_ns_ <= prev_stamp_ns_) return registration::Vec6d::Zero();
@@ -91,7 +97,10 @@ FrameResult ScanPipeline::process(const Scan& scan, const std::optional<SE3>& in
   out.sigma_m = threshold_.sigma_m();
   SE3 pose = out.initial_guess;
   if (backend_->map_voxels() > 0 && source.points > 0) {
-    out.registration = backend_->register_source(out.initial_guess, registration::Thresholds::from_sigma(out.sigma_m),
+    // the spacing as the backends' maps hold it (float)
+    const auto spacing_m = static_cast<float>(map::point_spacing_m(config_.map));
+    const double p2p = registration::point_to_point_precision(config_.registration, config_.map.covariance_epsilon, spacing_m);
+    out.registration = backend_->register_source(out.initial_guess, registration::Thresholds::from_sigma(out.sigma_m, p2p),
                                                  config_.registration,
                                                  config_.registration.time_budget_factor * period_s);
     out.registered = true;

@@ -59,6 +59,9 @@ class ScanPipeline {
   FrameResult process(const Scan& scan, const std::optional<SE3>& initial_guess = std::nullopt,
                       const std::optional<deskew::ScanMotion>& motion = std::nullopt);
 
+  /// Replaces the initial pose; only before the first scan (throws std::logic_error after).
+  void reset_initial_pose(const SE3& initial_pose);
+
   /// The backend that runs the stages (its submap, memory and device).
   [[nodiscard]] const ScanBackend& backend() const { return *backend_; }
   [[nodiscard]] ScanBackend& backend() { return *backend_; }

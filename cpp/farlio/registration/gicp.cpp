@@ -2,10 +2,18 @@
 
 #include <Eigen/Cholesky>
 #include <chrono>
+#include <cmath>
 
 #include "farlio/registration/factor_sums.hpp"
 
 namespace farlio::registration {
+
+double point_to_point_precision(const RegistrationConfig& config, double covariance_epsilon, double spacing_m) {
+  constexpr double kSigmaPerSpacing = 0.5;  // the matched sample may lie up to half a spacing away
+  const double sigma_m = config.point_to_point_sigma_m > 0.0 ? config.point_to_point_sigma_m : kSigmaPerSpacing * spacing_m;
+  const double sigma2 = sigma_m * sigma_m;
+  return sigma2 > 0.0 ? covariance_epsilon / sigma2 : 1.0;
+}
 
 SourceCloud source_from_map(const map::MapView& m, std::size_t voxel_capacity) {
   SourceCloud src;
@@ -19,19 +27,22 @@ SourceCloud source_from_map(const map::MapView& m, std::size_t voxel_capacity) {
   return src;
 }
 
-FactorParams factor_params(const SE3& T, const Thresholds& th, bool sparsity_aware) {
+FactorParams factor_params(const SE3& T, const Thresholds& th, const RegistrationConfig& config) {
   FactorParams fp;
   fp.R = T.rotation().cast<float>();
   fp.t = T.translation().cast<float>();
   fp.max_correspondence_distance2 = static_cast<float>(th.max_correspondence_m * th.max_correspondence_m);
   fp.kernel.kappa_m = static_cast<float>(th.kernel_scale_m);
-  fp.sparsity_aware = sparsity_aware;
+  fp.sparsity_aware = config.sparsity_aware;
+  fp.skip_line_pairs = config.skip_line_pairs;
+  fp.point_to_point_precision = static_cast<float>(th.point_to_point_precision);
   return fp;
 }
 
 LinearSystem build_linear_system(const SourceCloud& source, const map::MapView& target, const SE3& T,
-                                 const Thresholds& th, bool sparsity_aware, exec::CpuExecutor& executor) {
-  const FactorParams fp = factor_params(T, th, sparsity_aware);
+                                 const Thresholds& th, const RegistrationConfig& config,
+                                 exec::CpuExecutor& executor) {
+  const FactorParams fp = factor_params(T, th, config);
   const FactorSums sum = executor.reduce(
       source.size(), FactorSums::zero(),
       [&](std::size_t i) { return factor_sums(target, source.points[i], source.covs[i], fp); }, AddFactorSums{});
@@ -42,7 +53,7 @@ RegistrationResult register_scan(const SourceCloud& source, const map::MapView& 
                                  const Thresholds& th, const RegistrationConfig& config, double time_budget_s,
                                  exec::CpuExecutor& executor) {
   return gauss_newton(
-      [&](const SE3& T) { return build_linear_system(source, target, T, th, config.sparsity_aware, executor); },
+      [&](const SE3& T) { return build_linear_system(source, target, T, th, config, executor); },
       initial_guess, config, time_budget_s);
 }
 

@@ -15,7 +15,7 @@
 
 namespace farlio::registration {
 
-/// Registration input: points in the sensor frame, w = 1 where the covariance is valid.
+/// Registration input: points in the sensor frame, w = their map::PointShape.
 struct SourceCloud {
   std::vector<Eigen::Vector4f> points;
   std::vector<map::Cov3> covs;
@@ -34,19 +34,30 @@ struct RegistrationResult {
 /// The stored points of a map with their covariances (the per-scan frame map gives the source).
 SourceCloud source_from_map(const map::MapView& frame_map, std::size_t voxel_capacity);
 
-/// Correspondence distance (3 sigma) and kernel scale (sigma / 3), as in KISS-ICP.
+/// Correspondence distance (3 sigma) and kernel scale (sigma / 3), as in KISS-ICP, and the
+/// weight of point-to-point factors.
 struct Thresholds {
   double max_correspondence_m;
   double kernel_scale_m;
-  static Thresholds from_sigma(double sigma_m) { return {3.0 * sigma_m, sigma_m / 3.0}; }
+  double point_to_point_precision = 1.0;  ///< see point_to_point_precision()
+  static Thresholds from_sigma(double sigma_m, double p2p_precision = 1.0) {
+    return {3.0 * sigma_m, sigma_m / 3.0, p2p_precision};
+  }
 };
 
 /// The per-factor parameters at pose T (what every backend hands the shared factor body).
-FactorParams factor_params(const SE3& T, const Thresholds& th, bool sparsity_aware);
+FactorParams factor_params(const SE3& T, const Thresholds& th, const RegistrationConfig& config);
+
+/// The precision of a point-to-point factor in the units of the GICP factors, whose
+/// covariances are Frobenius-normalised so that a surface's normal variance of about
+/// covariance_epsilon (m^2) counts as 1: epsilon / sigma^2, with sigma from
+/// config.point_to_point_sigma_m or half the spacing.
+double point_to_point_precision(const RegistrationConfig& config, double covariance_epsilon, double spacing_m);
 
 /// The linear system of `source` at pose T against the map.
 LinearSystem build_linear_system(const SourceCloud& source, const map::MapView& target, const SE3& T,
-                                 const Thresholds& th, bool sparsity_aware, exec::CpuExecutor& executor);
+                                 const Thresholds& th, const RegistrationConfig& config,
+                                 exec::CpuExecutor& executor);
 
 RegistrationResult register_scan(const SourceCloud& source, const map::MapView& target, const SE3& initial_guess,
                                  const Thresholds& th, const RegistrationConfig& config, double time_budget_s,

@@ -4,8 +4,10 @@
 // current pose T = (R, t): p = R s + t is matched to its nearest map point q within the
 // correspondence distance; the residual r = p - q is weighted by
 //   Omega = (C_q + R C_s R^T)^-1   when both covariances exist (GICP),
-//   Omega = I                      otherwise (Sigma_r = I, Sigma_s = 0: point-to-point),
-// and by the Cauchy weight of |r|. The Jacobian of r under a right perturbation
+//   Omega = lambda I               otherwise (Sigma_r = I / lambda, Sigma_s = 0: point-to-point;
+//                                  the paper's lambda is 1, farlio's the map spacing's),
+// and by the Cauchy weight of |r|. A pair of two line-like covariances is left out with
+// skip_line_pairs. Plain ICP (sparsity_aware false) uses Omega = I for every pair. The Jacobian of r under a right perturbation
 // T exp(delta), delta = [rho; phi], is J = [R, -R [s]x].
 #include <Eigen/Core>
 #include <Eigen/LU>
@@ -32,6 +34,8 @@ struct FactorParams {
   float max_correspondence_distance2;
   CauchyKernel kernel;
   bool sparsity_aware;
+  bool skip_line_pairs = true;
+  float point_to_point_precision = 1.0f;  ///< lambda, in the Frobenius-normalised units of Omega
 };
 
 /// Computes the factor of source point `s` (w = 1 if `cov_s` is valid). Returns false (and
@@ -45,7 +49,10 @@ FARLIO_HD inline bool gicp_factor(const map::MapView& m, const Eigen::Vector4f& 
   const Eigen::Vector4f& q = m.points[nn];
   const Eigen::Vector3f r = p - q.head<3>();
   Eigen::Matrix3f omega = Eigen::Matrix3f::Identity();
-  if (fp.sparsity_aware && s.w() > 0.0f && q.w() > 0.0f) {
+  const bool both_covariances = map::has_covariance(s) && map::has_covariance(q);
+  if (fp.sparsity_aware && fp.skip_line_pairs && map::is_line_like(s) && map::is_line_like(q)) return false;
+  if (fp.sparsity_aware) omega *= fp.point_to_point_precision;
+  if (fp.sparsity_aware && both_covariances) {
     const Eigen::Matrix3f c = m.covs[nn].matrix() + fp.R * cov_s.matrix() * fp.R.transpose();
     const Eigen::Matrix3f inv = c.inverse();
     if (exec::all_finite(inv)) omega = inv;

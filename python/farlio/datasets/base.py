@@ -1,9 +1,28 @@
 """The dataset interface every dataloader implements."""
 from __future__ import annotations
 
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import farlio
+
+from .pointcloud2 import TimeOptions
+
+
+@dataclass
+class LoadOptions:
+    """What a dataloader may need beyond the path (all optional; `farlio run` options)."""
+
+    #: PointCloud2 topics of a bag; several are merged into one scan per period of the first
+    lidar_topics: list[str] = field(default_factory=list)
+    #: sensor_msgs/Imu topic of a bag ('none': LiDAR-only)
+    imu_topic: str | None = None
+    #: calibration YAML with T_imu_lidar (used where the recording has no extrinsic)
+    calib: Path | None = None
+    #: per-point time field, unit, header stamp meaning of PointCloud2 messages
+    time: TimeOptions = field(default_factory=TimeOptions)
+    #: sensor metadata json of an Ouster pcap (default: the pcap's name with .json, or the only json beside it)
+    meta: Path | None = None
 
 
 class Dataset:

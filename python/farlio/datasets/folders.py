@@ -6,7 +6,7 @@ from pathlib import Path
 import farlio
 from farlio import _core
 
-from .base import Dataset
+from .base import Dataset, LoadOptions
 
 POINT_CLOUD_SUFFIXES = (".pcd", ".pcd.gz", ".ply", ".bin")
 #: Scan period assumed for folders without stamps (10 Hz, the common spinning-LiDAR rate).
@@ -30,7 +30,7 @@ class SequenceFolder(Dataset):
     def matches(cls, path: Path) -> bool:
         return (path / "lidar").is_dir()
 
-    def __init__(self, path: Path):
+    def __init__(self, path: Path, options: LoadOptions | None = None):
         self.path = Path(path)
         self._reader = _core.io.SequenceReader(self.path)
 
@@ -88,7 +88,7 @@ class KittiOdometry(_FilesWithStamps):
     def matches(cls, path: Path) -> bool:
         return (path / "velodyne").is_dir()
 
-    def __init__(self, path: Path):
+    def __init__(self, path: Path, options: LoadOptions | None = None):
         self.path = Path(path)
         self._files = sorted(p for p in (self.path / "velodyne").iterdir() if p.suffix == ".bin")
         if not self._files:
@@ -113,7 +113,7 @@ class PointCloudFolder(_FilesWithStamps):
     def matches(cls, path: Path) -> bool:
         return path.is_dir() and any(_is_cloud(p) for p in path.iterdir())
 
-    def __init__(self, path: Path):
+    def __init__(self, path: Path, options: LoadOptions | None = None):
         self.path = Path(path)
         self._files = sorted(p for p in self.path.iterdir() if _is_cloud(p))
         stems = [p.name.split(".")[0] for p in self._files]

@@ -1,0 +1,86 @@
+#pragma once
+// LiDAR-inertial odometry for a live robot: IMU samples and scans are pushed from any thread as
+// they arrive, the scan pipeline runs on its own worker thread, and the fused 100 Hz odometry
+// comes out through a callback. The logic between the scan pipeline and the fusion is the
+// replay's (fusion_link.hpp); only the clock differs: here time is the newest IMU stamp, and a
+// scan's result is fused when its registration finishes, as a delayed measurement.
+//
+// Threads: add_imu() and add_scan() may be called from any threads (each kind in time order).
+// on_odometry runs on the thread that called add_imu(); on_frame runs on the worker (or on the
+// add_scan() caller for a dropped scan). Callbacks must not call back into the object.
+// A scan that arrives while the worker is still busy is dropped (as in the paper). Without an
+// IMU sample before the first scan, or with fusion.enabled off, the odometry is LiDAR-only and
+// on_odometry is not called.
+#include <condition_variable>
+#include <cstdint>
+#include <functional>
+#include <mutex>
+#include <optional>
+#include <thread>
+#include <vector>
+
+#include "farlio/core/config.hpp"
+#include "farlio/core/trajectory.hpp"
+#include "farlio/core/types.hpp"
+#include "farlio/fusion/sensor_fusion.hpp"
+#include "farlio/pipeline/odometry.hpp"
+#include "farlio/pipeline/scan_pipeline.hpp"
+
+namespace farlio::pipeline {
+
+class OnlineOdometry {
+ public:
+  using OdometryCallback = std::function<void(const OdometrySample&)>;
+  using FrameCallback = std::function<void(const OdometryFrame&)>;
+
+  OnlineOdometry(const Config& config, const SE3& T_imu_lidar, double gravity_m_s2, OdometryCallback on_odometry = {},
+                 FrameCallback on_frame = {});
+  ~OnlineOdometry();
+  OnlineOdometry(const OnlineOdometry&) = delete;
+  OnlineOdometry& operator=(const OnlineOdometry&) = delete;
+
+  /// Feeds the fusion and emits the odometry for every 10 ms step up to the sample's stamp.
+  void add_imu(const ImuSample& sample);
+  /// Hands the scan to the worker; false (and on_frame with the reason) when it is busy.
+  bool add_scan(Scan scan);
+  /// Blocks until the worker has finished every scan handed to it.
+  void wait_idle();
+  /// Finishes the scan in progress, then ends the worker (also done by the destructor).
+  void stop();
+
+  /// Whether the fusion is in use (decided at the first scan).
+  [[nodiscard]] bool inertial() const;
+  [[nodiscard]] std::optional<fusion::FusionStats> fusion_stats() const;
+  /// Scans dropped because the worker was busy.
+  [[nodiscard]] std::size_t scans_dropped_busy() const;
+
+ private:
+  void worker_loop();
+  OdometryFrame process(const Scan& scan);
+
+  const Config config_;
+  const SE3 T_imu_lidar_, T_lidar_imu_;
+  OdometryCallback on_odometry_;
+  FrameCallback on_frame_;
+
+  // fusion state, guarded by state_mutex_
+  mutable std::mutex state_mutex_;
+  std::optional<fusion::SensorFusion> fusion_;
+  std::vector<ImuSample> startup_imu_;  // the first kGravityAlignmentWindow_s, for the start pose
+  bool inertial_decided_ = false, inertial_ = false;
+  std::int64_t next_output_ns_ = 0;
+  std::optional<StampedPose> last_body_;
+  std::size_t dropped_busy_ = 0;
+
+  std::mutex emit_mutex_;  // keeps on_odometry calls in order
+
+  // worker, guarded by queue_mutex_
+  std::mutex queue_mutex_;
+  std::condition_variable queue_cv_;
+  std::optional<Scan> pending_;
+  bool busy_ = false, stopping_ = false;
+  std::optional<ScanPipeline> pipeline_;  // worker only; created at the first scan
+  std::thread worker_;
+};
+
+}  // namespace farlio::pipeline
