@@ -59,9 +59,9 @@ struct PyOnlineOdometry {
   }
 };
 
-Eigen::MatrixX3f map_points(const map::VoxelMap& m) {
+Eigen::MatrixX3f map_points(const pipeline::ScanBackend& b) {
   std::vector<Eigen::Vector3f> pts;
-  m.for_each_point([&](const Eigen::Vector3f& x, const map::Cov3&, bool) { pts.push_back(x); });
+  b.map_snapshot().for_each_point([&](const Eigen::Vector3f& x, const map::Cov3&, bool) { pts.push_back(x); });
   Eigen::MatrixX3f out(static_cast<Eigen::Index>(pts.size()), 3);
   for (std::size_t i = 0; i < pts.size(); ++i) out.row(static_cast<Eigen::Index>(i)) = pts[i].transpose();
   return out;
@@ -95,7 +95,8 @@ void bind_pipeline(nb::module_& m) {
       .def_ro("covariance_s", &pipeline::FrameTimings::covariance_s)
       .def_ro("registration_s", &pipeline::FrameTimings::registration_s)
       .def_ro("map_update_s", &pipeline::FrameTimings::map_update_s)
-      .def_ro("total_s", &pipeline::FrameTimings::total_s);
+      .def_ro("total_s", &pipeline::FrameTimings::total_s)
+      .def_ro("device_timed", &pipeline::FrameTimings::device_timed, "stage times from CUDA events");
 
   nb::class_<pipeline::FrameResult>(m, "FrameResult", "What the scan pipeline made of one scan.")
       .def_ro("stamp_ns", &pipeline::FrameResult::stamp_ns)
@@ -192,10 +193,14 @@ void bind_pipeline(nb::module_& m) {
       .def_prop_ro("initial_body_pose", [](const PyOdometry& o) { return o.odometry.initial_body_pose(); })
       .def(
           "map_points",
-[](const PyOdometry& o) { return map_points(o.odometry.scan_pipeline().local_map()); },
+[](const PyOdometry& o) { return map_points(o.odometry.scan_pipeline().backend()); },
           "(N, 3) float32 copy of the submap's points (world frame)")
       .def_prop_ro("map_memory_bytes",
-                   [](const PyOdometry& o) { return o.odometry.scan_pipeline().local_map().memory_bytes(); });
+                   [](const PyOdometry& o) { return o.odometry.scan_pipeline().backend().memory_bytes(); })
+      .def_prop_ro("device", [](const PyOdometry& o) { return device_name(o.odometry.scan_pipeline().backend().device()); },
+                   "'cpu' or 'cuda': the backend the scan pipeline runs on")
+      .def_prop_ro("device_message", [](const PyOdometry& o) { return o.odometry.scan_pipeline().device_message(); },
+                   "why device auto fell back to the CPU ('' when it did not)");
 
   nb::class_<pipeline::OdometrySample>(m, "OdometrySample", "One 10 ms sample of the fused odometry.")
       .def_ro("stamp_ns", &pipeline::OdometrySample::stamp_ns)
@@ -236,9 +241,13 @@ void bind_pipeline(nb::module_& m) {
       .def_prop_ro("frames", &pipeline::ScanPipeline::frames)
       .def(
           "map_points",
-[](const pipeline::ScanPipeline& p) { return map_points(p.local_map()); },
+[](const pipeline::ScanPipeline& p) { return map_points(p.backend()); },
           "(N, 3) float32 copy of the submap's points (world frame)")
-      .def_prop_ro("map_memory_bytes", [](const pipeline::ScanPipeline& p) { return p.local_map().memory_bytes(); });
+      .def_prop_ro("map_memory_bytes", [](const pipeline::ScanPipeline& p) { return p.backend().memory_bytes(); })
+      .def_prop_ro("device", [](const pipeline::ScanPipeline& p) { return device_name(p.backend().device()); },
+                   "'cpu' or 'cuda': the backend the stages run on")
+      .def_prop_ro("device_message", &pipeline::ScanPipeline::device_message,
+                   "why device auto fell back to the CPU ('' when it did not)");
 }
 
 }  // namespace farlio::python

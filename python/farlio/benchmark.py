@@ -3,6 +3,7 @@ process and run, one after the other per frame set. Reports per-frame latency (m
 and, when the scans have ground truth, the accuracy of both."""
 from __future__ import annotations
 
+import sys
 import time
 from typing import Any
 
@@ -50,15 +51,18 @@ def _accuracy(traj: Any, gt: Any) -> dict[str, float] | None:
             "rpe_deg_per_100m": r.kitti_rpe.rotation_deg_per_100m}
 
 
-def run_farlio(scans: list[Any], config: Any) -> tuple[list[float], Any]:
+def run_farlio(scans: list[Any], config: Any) -> tuple[list[float], Any, str]:
+    """(latency per frame in ms, trajectory, the device it ran on)."""
     pipe = _core.ScanPipeline(config)
+    if pipe.device_message:
+        print(f"farlio: {pipe.device_message}", file=sys.stderr)
     ms, traj = [], farlio.Trajectory()
     for s in scans:
         t0 = time.perf_counter()
         r = pipe.process(s)
         ms.append((time.perf_counter() - t0) * MS_PER_S)
         traj.push_back(r.stamp_ns, r.pose)
-    return ms, traj
+    return ms, traj, pipe.device
 
 
 def run_kiss(scans: list[Any], threads: int) -> tuple[list[float], Any]:
@@ -87,13 +91,15 @@ def run_kiss(scans: list[Any], threads: int) -> tuple[list[float], Any]:
     return ms, traj
 
 
-def compare(scans: list[Any], gt: Any = None, *, threads: int = 0, with_kiss: bool = True) -> dict[str, Any]:
-    """Runs farlio (LiDAR-only scan pipeline) and, if installed, KISS-ICP over the same scans."""
+def compare(scans: list[Any], gt: Any = None, *, threads: int = 0, with_kiss: bool = True,
+            device: str = "auto") -> dict[str, Any]:
+    """Runs farlio (LiDAR-only scan pipeline, on `device`) and, if installed, KISS-ICP over the same scans."""
     config = _core.Config()
     config.set("num_threads", str(threads))
-    ms, traj = run_farlio(scans, config)
+    config.set("device", device)
+    ms, traj, used = run_farlio(scans, config)
     result: dict[str, Any] = {"frames": len(scans), "points_per_scan": float(np.mean([len(s) for s in scans])),
-                              "threads": threads, "farlio": {"latency_ms": _stats(ms), "accuracy": _accuracy(traj, gt)}}
+                              "threads": threads, "device": used, "farlio": {"latency_ms": _stats(ms), "accuracy": _accuracy(traj, gt)}}
     if with_kiss:
         try:
             kms, ktraj = run_kiss(scans, threads)
@@ -107,7 +113,8 @@ def compare(scans: list[Any], gt: Any = None, *, threads: int = 0, with_kiss: bo
 
 
 def format_table(name: str, r: dict[str, Any]) -> str:
-    rows = [f"{name}: {r['frames']} frames of {r['points_per_scan']:.0f} points, threads={r['threads'] or 'all'}",
+    rows = [f"{name}: {r['frames']} frames of {r['points_per_scan']:.0f} points, threads={r['threads'] or 'all'}, "
+            f"farlio on {r.get('device', 'cpu')}",
             f"{'system':10s} {'median ms':>10s} {'p99 ms':>10s} {'max ms':>10s} {'APE m':>8s} {'RPE %':>8s}"]
     for key in ("farlio", "kiss_icp"):
         v = r.get(key)

@@ -5,7 +5,8 @@ Outputs in the output folder (every trajectory file names its frame):
   scans_body.tum         registered body (IMU) pose at every scan end = LiDAR pose * T_imu_lidar^-1
   odometry_body.tum      the fused 100 Hz body odometry (LIO only; flushed as it goes)
   scans_lidar_kitti.txt  LiDAR poses relative to the first (KITTI 3x4), written at the end
-  timing.csv             per-frame stage timings, counts and what happened to the frame (flushed)
+  timing.csv             per-frame stage timings (stage_clock: wall or cuda_events), counts and what
+                         happened to the frame (flushed)
   summary.json           frames, median/p99 latency, converged fraction, accuracy with ground truth
   config.yaml            the full effective parameter set
   eval_scans/, eval_odometry/   eval.json + eval.png against the ground truth, when there is one
@@ -32,10 +33,14 @@ from .datasets import Dataset
 from .progress import Progress
 
 MS_PER_S = 1e3
+#: values of --device and of the config field device
+DEVICES = ("auto", "cpu", "cuda")
+#: timing.csv's stage_clock: the stage times are wall clock (CPU) or CUDA events (GPU timeline)
+STAGE_CLOCKS = {False: "wall", True: "cuda_events"}
 TIMING_COLUMNS = ["frame", "stamp_ns", "input_points", "kept_points", "source_points", "registered", "converged",
                   "iterations", "inliers", "sigma_m", "density_limit", "map_voxels", "map_points",
                   "preprocess_ms", "covariance_ms", "registration_ms", "map_update_ms", "total_ms",
-                  "fused", "guess_from_fusion", "latency_ms", "drop_reason"]
+                  "stage_clock", "fused", "guess_from_fusion", "latency_ms", "drop_reason"]
 LATENCY_MODELS = {"measured": _core.LatencyModel.Measured, "zero": _core.LatencyModel.Zero,
                   "fixed": _core.LatencyModel.Fixed}
 
@@ -79,6 +84,11 @@ def run_dataset(dataset: Dataset, out_dir: Path, config: Any = None, *, max_fram
     T_imu_lidar = dataset.T_imu_lidar()
     imu = dataset.imu() if use_imu else []
     odo = _core.Odometry(config, T_imu_lidar, dataset.gravity_m_s2(), imu, options or replay_options())
+    if odo.device_message:
+        print(f"farlio: {odo.device_message}", file=sys.stderr)
+    elif odo.device == "cuda":
+        print(f"farlio: CUDA backend, {odo.map_memory_bytes / 2**20:.0f} MiB of device memory preallocated",
+              file=sys.stderr)
     lidar_tum = _core.io.TrajectoryWriter(out_dir / "scans_lidar.tum")
     body_tum = _core.io.TrajectoryWriter(out_dir / "scans_body.tum")
     odom_tum = _core.io.TrajectoryWriter(out_dir / "odometry_body.tum") if odo.inertial else None
@@ -131,7 +141,7 @@ def run_dataset(dataset: Dataset, out_dir: Path, config: Any = None, *, max_fram
                              r.map_voxels, r.map_points] +
                             [f"{v * MS_PER_S:.3f}" for v in (t.preprocess_s, t.covariance_s, t.registration_s,
                                                              t.map_update_s, t.total_s)] +
-                            [int(fr.fused), int(fr.guess_from_fusion),
+                            [STAGE_CLOCKS[t.device_timed], int(fr.fused), int(fr.guess_from_fusion),
                              f"{(fr.available_ns - fr.started_ns) / 1e6:.3f}", fr.drop_reason])
             if on_frame is not None:
                 on_frame(i, scan, fr)
@@ -168,6 +178,7 @@ def run_dataset(dataset: Dataset, out_dir: Path, config: Any = None, *, max_fram
                        "mean": float(np.mean(totals_ms)) if totals_ms else float("nan")},
         "wall_s": wall_s,
         "rate_hz": len(totals_ms) / wall_s if wall_s > 0 else float("nan"),
+        "device": odo.device,
         "map_memory_bytes": odo.map_memory_bytes,
         "threads": config.get("num_threads"),
     }

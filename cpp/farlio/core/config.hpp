@@ -5,6 +5,8 @@
 // (e.g. `map.voxel_size_m`); a run writes the full effective config next to its outputs.
 #include <cstdint>
 
+#include "farlio/core/device.hpp"
+
 namespace farlio {
 
 /// Range crop and downsampling of each incoming scan.
@@ -128,6 +130,14 @@ struct FusionConfig {
   int accel_unit_detection_samples = 50; ///< mean |a| over these first samples decides the unit
 };
 
+/// The CUDA backend's device buffers, all allocated once when the pipeline starts (docs/cuda.md).
+/// A scan or map beyond them raises CapacityError naming the field to raise.
+struct CudaConfig {
+  std::int64_t max_scan_points = 1 << 19;    ///< points of one scan, all LiDARs merged (racetrack: ~210k)
+  std::int64_t max_map_voxels = 1 << 18;     ///< submap voxels on the device (N_max points each)
+  std::int64_t max_frame_voxels = 1 << 16;   ///< voxels of the per-scan frame map
+};
+
 struct Config {
   PreprocessConfig preprocess;
   VoxelMapConfig map;
@@ -135,6 +145,8 @@ struct Config {
   ThresholdConfig threshold;
   RegistrationConfig registration;
   FusionConfig fusion;
+  CudaConfig cuda;
+  Device device = Device::Auto;         ///< backend of the scan pipeline: auto (CUDA if a GPU is present), cpu, cuda
   int num_threads = 0;                  ///< CPU threads of this pipeline instance (0: all)
 };
 

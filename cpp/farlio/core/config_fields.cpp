@@ -87,6 +87,10 @@ std::vector<ConfigField> config_fields(Config& c) {
       {"fusion.accel_bias_z_m_s2", &c.fusion.accel_bias_z_m_s2, "accelerometer bias z (not estimated, as in the paper)"},
       {"fusion.accel_unit_detection", &c.fusion.accel_unit_detection, "detect an accelerometer reporting in g and scale it"},
       {"fusion.accel_unit_detection_samples", &c.fusion.accel_unit_detection_samples, "first samples whose mean |accel| decides the unit"},
+      {"cuda.max_scan_points", &c.cuda.max_scan_points, "device buffers: points of one scan (all LiDARs merged)"},
+      {"cuda.max_map_voxels", &c.cuda.max_map_voxels, "device buffers: submap voxels (N_max points each)"},
+      {"cuda.max_frame_voxels", &c.cuda.max_frame_voxels, "device buffers: voxels of the per-scan frame map"},
+      {"device", &c.device, "scan pipeline backend: auto (CUDA when a GPU is present, else CPU), cpu or cuda"},
       {"num_threads", &c.num_threads, "CPU threads of this pipeline (0: all)"},
   };
 }
@@ -140,7 +144,9 @@ void set_config_field(Config& config, const std::string& name, const std::string
   std::visit(
       [&](auto* p) {
         using T = std::remove_pointer_t<decltype(p)>;
-        if constexpr (std::is_same_v<T, bool>) {
+        if constexpr (std::is_same_v<T, Device>) {
+          *p = parse_device(value, name);
+        } else if constexpr (std::is_same_v<T, bool>) {
           if (value == "true" || value == "True" || value == "1") *p = true;
           else if (value == "false" || value == "False" || value == "0") *p = false;
           else throw std::invalid_argument("config field '" + name + "': expected true or false, got '" + value + "'");
@@ -158,7 +164,9 @@ std::string get_config_field(const Config& config, const std::string& name) {
   std::visit(
       [&](auto* p) {
         using T = std::remove_pointer_t<decltype(p)>;
-        if constexpr (std::is_same_v<T, bool>) {
+        if constexpr (std::is_same_v<T, Device>) {
+          os << device_name(*p);
+        } else if constexpr (std::is_same_v<T, bool>) {
           os << (*p ? "true" : "false");
         } else {
           char buf[64];  // shortest text that reads back to the same value

@@ -13,7 +13,7 @@ namespace farlio {
 
 struct ConfigField {
   std::string name;
-  std::variant<double*, int*, std::int64_t*, bool*> value;
+  std::variant<double*, int*, std::int64_t*, bool*, Device*> value;
   std::string doc;
 };
 

@@ -13,13 +13,29 @@ bool cuda_compiled() { return false; }
 int cuda_device_count() { return 0; }
 #endif
 
+const char* device_name(Device d) {
+  switch (d) {
+    case Device::Cpu: return "cpu";
+    case Device::Cuda: return "cuda";
+    case Device::Auto: break;
+  }
+  return "auto";
+}
+
+Device parse_device(const std::string& text, const std::string& what) {
+  for (const Device d : {Device::Cpu, Device::Cuda, Device::Auto}) {
+    if (text == device_name(d)) return d;
+  }
+  throw std::invalid_argument(what + ": expected auto, cpu or cuda, got '" + text + "'");
+}
+
 Device resolve_device(Device requested, std::string* message) {
   if (requested == Device::Cpu) return Device::Cpu;
   const bool built = cuda_compiled();
   const int n = built ? cuda_device_count() : 0;
   if (n > 0) return Device::Cuda;
   const std::string why = built ? "no CUDA device was found" : "this build has no CUDA backend";
-  if (requested == Device::Cuda) throw std::runtime_error("--device cuda was requested but " + why);
+  if (requested == Device::Cuda) throw std::runtime_error("device cuda was requested but " + why + " (use --device auto or cpu)");
   if (message) *message = "device auto: " + why + "; running on the CPU";
   return Device::Cpu;
 }

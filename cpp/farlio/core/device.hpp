@@ -6,6 +6,11 @@ namespace farlio {
 
 enum class Device { Cpu, Cuda, Auto };
 
+/// "cpu", "cuda" or "auto".
+const char* device_name(Device d);
+/// Parses "cpu", "cuda" or "auto"; throws std::invalid_argument naming `what` otherwise.
+Device parse_device(const std::string& text, const std::string& what = "device");
+
 /// True if this build contains the CUDA backend.
 bool cuda_compiled();
 /// Number of usable CUDA devices (0 without the backend, a driver or a GPU).

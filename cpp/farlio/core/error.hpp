@@ -18,4 +18,10 @@ class CapacityError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// A CUDA runtime call failed; the message names the call, its file:line and the CUDA error.
+class DeviceError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 }  // namespace farlio

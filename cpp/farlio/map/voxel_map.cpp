@@ -9,20 +9,11 @@
 #include <string>
 
 #include "farlio/core/error.hpp"
-#include "farlio/map/neighbor_search.hpp"
+#include "farlio/map/voxel_update.hpp"
 
 namespace farlio::map {
 namespace {
-// The table keeps at least this many slots per voxel of pool capacity (load factor <= 0.5).
-constexpr std::size_t kSlotsPerVoxel = 2;
-// Rehash (in place) when erased markers exceed this fraction of the table.
-constexpr double kMaxErasedFraction = 0.25;
-
 std::size_t next_pow2(std::size_t n) { return std::bit_ceil(std::max<std::size_t>(n, 16)); }
-
-struct GroupStats {
-  std::int32_t inserted = 0, spacing = 0, full = 0;
-};
 }  // namespace
 
 double point_spacing_m(const VoxelMapConfig& config) {
@@ -30,15 +21,21 @@ double point_spacing_m(const VoxelMapConfig& config) {
                                       : config.voxel_size_m / std::sqrt(static_cast<double>(config.max_points_per_voxel));
 }
 
-VoxelMap::VoxelMap(const VoxelMapConfig& config, exec::CpuExecutor& executor)
-    : config_(config),
-      executor_(&executor),
-      spacing_m_(static_cast<float>(point_spacing_m(config))) {
+std::size_t table_capacity_for(std::size_t voxel_capacity) { return next_pow2(kSlotsPerVoxel * voxel_capacity); }
+
+void validate_map_config(const VoxelMapConfig& config) {
   if (config.voxel_size_m <= 0 || config.max_points_per_voxel <= 0 || config.covariance_neighbors <= 0 ||
       config.covariance_neighbors > kMaxNeighbors) {
     throw std::invalid_argument("VoxelMap: voxel_size_m and max_points_per_voxel must be > 0 and "
                                 "covariance_neighbors in [1, " + std::to_string(kMaxNeighbors) + "]");
   }
+}
+
+VoxelMap::VoxelMap(const VoxelMapConfig& config, exec::CpuExecutor& executor)
+    : config_(config),
+      executor_(&executor),
+      spacing_m_(static_cast<float>(point_spacing_m(config))) {
+  validate_map_config(config);
   reserve_voxels(static_cast<std::size_t>(std::max<std::int64_t>(config.initial_voxel_capacity, 1)));
 }
 
@@ -73,7 +70,7 @@ void VoxelMap::reserve_voxels(std::size_t needed) {
     points_.resize(new_cap * n, Eigen::Vector4f::Zero());
     covs_.resize(new_cap * n);
   }
-  if (slot_keys_.size() < kSlotsPerVoxel * voxel_keys_.size()) rehash(next_pow2(kSlotsPerVoxel * voxel_keys_.size()));
+  if (slot_keys_.size() < kSlotsPerVoxel * voxel_keys_.size()) rehash(table_capacity_for(voxel_keys_.size()));
 }
 
 void VoxelMap::rehash(std::size_t slots) {
@@ -113,13 +110,7 @@ InsertStats VoxelMap::insert(const std::vector<Eigen::Vector3f>& points, const E
   // 1. group candidates by voxel, in input order inside a voxel
   std::vector<std::pair<std::uint64_t, std::int32_t>> keyed(points.size());
   executor_->for_each(points.size(), [&](std::size_t i) {
-    const Eigen::Vector3f& p = points[i];
-    std::uint64_t key = kEmptyKey;
-    if (p.allFinite()) {
-      const VoxelCoord c = voxel_of(p, inv_voxel);
-      if (in_key_range(c)) key = pack_key(c);
-    }
-    keyed[i] = {key, static_cast<std::int32_t>(i)};
+    keyed[i] = {point_key(points[i], inv_voxel), static_cast<std::int32_t>(i)};
   });
   executor_->run([&] { tbb::parallel_sort(keyed.begin(), keyed.end()); });
   while (!keyed.empty() && keyed.back().first == kEmptyKey) {
@@ -163,37 +154,17 @@ InsertStats VoxelMap::insert(const std::vector<Eigen::Vector3f>& points, const E
   }
 
   // 3. insert each voxel's candidates in order, with the cap and the spacing
-  const float spacing2 = spacing_m_ * spacing_m_;
-  const int n_max = config_.max_points_per_voxel;
+  const InsertParams ip{origin, limit, spacing_m_ * spacing_m_};
   std::vector<std::int32_t> first_new(groups);
   std::vector<GroupStats> gstats(groups);
-  executor_->for_each(groups, [&](std::size_t g) {
-    const auto v = static_cast<std::size_t>(group_voxel[g]);
-    const std::size_t base = v * static_cast<std::size_t>(n_max);
-    std::int32_t count = voxel_counts_[v];
-    first_new[g] = count;
-    GroupStats& s = gstats[g];
-    for (std::size_t c = group_start[g]; c < group_start[g + 1]; ++c) {
-      const Eigen::Vector3f& p = points[static_cast<std::size_t>(keyed[c].second)];
-      const int lim = std::min(n_max, limit.at((p - origin).norm()));
-      if (count >= lim) {
-        ++s.full;
-        continue;
-      }
-      bool too_close = false;
-      for (std::int32_t j = 0; j < count && !too_close; ++j) {
-        too_close = (points_[base + static_cast<std::size_t>(j)].head<3>() - p).squaredNorm() < spacing2;
-      }
-      if (too_close) {
-        ++s.spacing;
-        continue;
-      }
-      points_[base + static_cast<std::size_t>(count)] = Eigen::Vector4f(p.x(), p.y(), p.z(), 0.0f);
-      ++count;
-      ++s.inserted;
-    }
-    voxel_counts_[v] = count;
-  });
+  {
+    const MapView v = view();
+    const auto candidate = [&](std::int64_t c) { return points[static_cast<std::size_t>(keyed[static_cast<std::size_t>(c)].second)]; };
+    executor_->for_each(groups, [&](std::size_t g) {
+      gstats[g] = insert_voxel_group(v, group_voxel[g], candidate, static_cast<std::int64_t>(group_start[g]),
+                                     static_cast<std::int64_t>(group_start[g + 1]), ip, &first_new[g]);
+    });
+  }
   for (const auto& s : gstats) {
     stats.inserted += static_cast<std::size_t>(s.inserted);
     stats.rejected_spacing += static_cast<std::size_t>(s.spacing);
@@ -218,26 +189,8 @@ void VoxelMap::compute_covariances(const std::vector<std::int32_t>& voxels, cons
   const int k = config_.covariance_neighbors;
   const auto eps = static_cast<float>(config_.covariance_epsilon);
   const auto line_ratio = static_cast<float>(config_.line_eigenvalue_ratio);
-  executor_->for_each(voxels.size(), [&](std::size_t i) {
-    const std::int32_t vox = voxels[i];
-    const std::int32_t count = v.voxel_counts[vox];
-    std::int64_t idx[kMaxNeighbors];
-    float d2[kMaxNeighbors];
-    for (std::int32_t j = first_point[i]; j < count; ++j) {
-      const std::int64_t pi = v.point_index(vox, j);
-      const Eigen::Vector3f p = v.points[pi].head<3>();
-      const int found = knn_search(v, p, k, std::numeric_limits<float>::max(), idx, d2);
-      if (found < k) {
-        v.points[pi].w() = shape_code(PointShape::NoCovariance);
-        continue;
-      }
-      CovarianceAccumulator acc(p);
-      for (int n = 0; n < found; ++n) acc.add(v.points[idx[n]].head<3>());
-      const Eigen::Matrix3f cov = regularize_frobenius(acc.covariance(), eps);
-      v.covs[pi] = Cov3::from(cov);
-      v.points[pi].w() = shape_code(classify_shape(cov, line_ratio));
-    }
-  });
+  executor_->for_each(voxels.size(),
+                      [&](std::size_t i) { update_voxel_covariances(v, voxels[i], first_point[i], k, eps, line_ratio); });
 }
 
 std::size_t VoxelMap::remove_far(const Eigen::Vector3f& origin) {
@@ -248,10 +201,8 @@ std::size_t VoxelMap::remove_far(const Eigen::Vector3f& origin) {
   for (std::size_t i = 0; i < high_water_; ++i) {
     const std::uint64_t key = voxel_keys_[i];
     if (key == kEmptyKey) continue;
-    const VoxelCoord c = unpack_key(key);
-    const Eigen::Vector3d centre = (c.cast<double>() + Eigen::Vector3d::Constant(0.5)) * vs;
-    if ((centre - origin.cast<double>()).squaredNorm() <= r2) continue;
-    table_erase(v, key, spatial_hash(c));
+    if (voxel_centre_distance2(key, origin.cast<double>(), vs) <= r2) continue;
+    table_erase(v, key, spatial_hash(unpack_key(key)));
     voxel_keys_[i] = kEmptyKey;
     voxel_counts_[i] = 0;
     free_voxels_.push_back(static_cast<std::int32_t>(i));
@@ -286,14 +237,21 @@ std::size_t VoxelMap::memory_bytes() const {
          points_.capacity() * sizeof(Eigen::Vector4f) + covs_.capacity() * sizeof(Cov3);
 }
 
-void VoxelMap::for_each_point(const std::function<void(const Eigen::Vector3f&, const Cov3&, bool)>& f) const {
+MapSnapshot VoxelMap::snapshot() const {
   const auto n = static_cast<std::size_t>(config_.max_points_per_voxel);
-  for (std::size_t v = 0; v < high_water_; ++v) {
-    for (std::size_t j = 0; j < static_cast<std::size_t>(voxel_counts_[v]); ++j) {
-      const Eigen::Vector4f& p = points_[v * n + j];
-      f(p.head<3>(), covs_[v * n + j], has_covariance(p));
-    }
-  }
+  const auto hw = static_cast<std::ptrdiff_t>(high_water_);
+  const auto hw_points = static_cast<std::ptrdiff_t>(high_water_ * n);
+  MapSnapshot s;
+  s.max_points_per_voxel = config_.max_points_per_voxel;
+  s.voxel_keys.assign(voxel_keys_.begin(), voxel_keys_.begin() + hw);
+  s.voxel_counts.assign(voxel_counts_.begin(), voxel_counts_.begin() + hw);
+  s.points.assign(points_.begin(), points_.begin() + hw_points);
+  s.covs.assign(covs_.begin(), covs_.begin() + hw_points);
+  return s;
+}
+
+void VoxelMap::for_each_point(const std::function<void(const Eigen::Vector3f&, const Cov3&, bool)>& f) const {
+  snapshot().for_each_point(f);
 }
 
 double VoxelMap::mean_points_per_voxel(const Eigen::Vector3f& origin, double range_m) const {
@@ -301,8 +259,7 @@ double VoxelMap::mean_points_per_voxel(const Eigen::Vector3f& origin, double ran
   std::size_t voxels = 0, pts = 0;
   for (std::size_t v = 0; v < high_water_; ++v) {
     if (voxel_keys_[v] == kEmptyKey) continue;
-    const Eigen::Vector3d centre = (unpack_key(voxel_keys_[v]).cast<double>() + Eigen::Vector3d::Constant(0.5)) * vs;
-    if ((centre - origin.cast<double>()).norm() > range_m) continue;
+    if (std::sqrt(voxel_centre_distance2(voxel_keys_[v], origin.cast<double>(), vs)) > range_m) continue;
     ++voxels;
     pts += static_cast<std::size_t>(voxel_counts_[v]);
   }

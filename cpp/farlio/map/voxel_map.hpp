@@ -14,26 +14,22 @@
 
 #include "farlio/core/config.hpp"
 #include "farlio/exec/cpu_executor.hpp"
+#include "farlio/map/map_snapshot.hpp"
 #include "farlio/map/map_view.hpp"
+#include "farlio/map/point_limit.hpp"
 
 namespace farlio::map {
 
-/// The per-voxel point limit for a point at a given distance from the sensor (ASMD, or a
-/// constant). Evaluated per inserted point.
-struct PointLimit {
-  int close_limit = 40;          ///< limit within close_range_m
-  float close_range_m = 0.0f;    ///< beyond it the limit decays linearly
-  float slope_per_m = 0.0f;      ///< points per metre of decay
-  int min_limit = 40;            ///< floor of the decay (k, so covariances stay computable)
+/// The table keeps at least this many slots per voxel of pool capacity (load factor <= 0.5).
+inline constexpr std::size_t kSlotsPerVoxel = 2;
+/// Rehash (in place) when erased markers exceed this fraction of the table.
+inline constexpr double kMaxErasedFraction = 0.25;
 
-  static PointLimit constant(int n) { return {n, 0.0f, 0.0f, n}; }
-  FARLIO_HD int at(float distance_m) const {
-    if (distance_m <= close_range_m) return close_limit;
-    const float decayed = static_cast<float>(close_limit) - slope_per_m * (distance_m - close_range_m);
-    const int lim = static_cast<int>(decayed);
-    return lim > min_limit ? lim : min_limit;
-  }
-};
+/// Slots of the table for a pool of `voxel_capacity` voxels (a power of two).
+std::size_t table_capacity_for(std::size_t voxel_capacity);
+
+/// Throws std::invalid_argument when the sizes of `config` cannot make a map.
+void validate_map_config(const VoxelMapConfig& config);
 
 /// The minimum distance between points of a voxel: config.point_spacing_m, or
 /// voxel_size_m / sqrt(max_points_per_voxel) when that is 0.
@@ -74,6 +70,8 @@ class VoxelMap {
   [[nodiscard]] std::size_t table_capacity() const { return slot_keys_.size(); }
   [[nodiscard]] std::size_t memory_bytes() const;
 
+  /// A copy of the used part of the pool (voxels [0, high water)).
+  [[nodiscard]] MapSnapshot snapshot() const;
   /// Calls f(point, covariance, covariance_valid) for every stored point (host only).
   void for_each_point(const std::function<void(const Eigen::Vector3f&, const Cov3&, bool)>& f) const;
   /// Mean number of points per voxel over voxels whose centre lies within `range_m` of

@@ -5,18 +5,17 @@
 #include <algorithm>
 #include <cmath>
 
-#include "farlio/map/voxel_key.hpp"
+#include "farlio/map/voxel_update.hpp"
+#include "farlio/pipeline/range_crop.hpp"
 
 namespace farlio::pipeline {
 
 std::vector<std::int32_t> crop_by_range(const std::vector<Eigen::Vector3f>& points, const PreprocessConfig& config) {
-  const auto lo2 = static_cast<float>(config.min_range_m * config.min_range_m);
-  const auto hi2 = static_cast<float>(config.max_range_m * config.max_range_m);
+  const RangeCrop crop = RangeCrop::from(config);
   std::vector<std::int32_t> kept;
   kept.reserve(points.size());
   for (std::size_t i = 0; i < points.size(); ++i) {
-    const float r2 = points[i].squaredNorm();
-    if (std::isfinite(r2) && r2 >= lo2 && r2 <= hi2) kept.push_back(static_cast<std::int32_t>(i));
+    if (crop.keeps(points[i])) kept.push_back(static_cast<std::int32_t>(i));
   }
   return kept;
 }
@@ -28,14 +27,20 @@ std::vector<std::int32_t> voxel_downsample(const std::vector<Eigen::Vector3f>& p
   std::vector<std::pair<std::uint64_t, std::int32_t>> keyed(indices.size());
   const float inv = 1.0f / cell_m;
   executor.for_each(indices.size(), [&](std::size_t i) {
-    const map::VoxelCoord c = map::voxel_of(points[static_cast<std::size_t>(indices[i])], inv);
-    keyed[i] = {map::in_key_range(c) ? map::pack_key(c) : map::kEmptyKey, static_cast<std::int32_t>(i)};
+    keyed[i] = {map::point_key(points[static_cast<std::size_t>(indices[i])], inv), static_cast<std::int32_t>(i)};
   });
+  std::vector<std::int32_t> kept = first_of_each_cell(keyed, executor);
+  for (auto& k : kept) k = indices[static_cast<std::size_t>(k)];
+  return kept;
+}
+
+std::vector<std::int32_t> first_of_each_cell(std::vector<std::pair<std::uint64_t, std::int32_t>>& keyed,
+                                             exec::CpuExecutor& executor) {
   executor.run([&] { tbb::parallel_sort(keyed.begin(), keyed.end()); });
   std::vector<std::int32_t> kept;
   for (std::size_t i = 0; i < keyed.size(); ++i) {
     if (keyed[i].first == map::kEmptyKey) break;
-    if (i == 0 || keyed[i].first != keyed[i - 1].first) kept.push_back(indices[static_cast<std::size_t>(keyed[i].second)]);
+    if (i == 0 || keyed[i].first != keyed[i - 1].first) kept.push_back(keyed[i].second);
   }
   return kept;
 }

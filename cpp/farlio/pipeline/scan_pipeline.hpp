@@ -7,29 +7,24 @@
 //   -> pose and velocity out (eq. 6).
 // The initial guess and the motion during the scan come from the sensor fusion when given;
 // otherwise from a constant-velocity model (LiDAR-only odometry). Poses are of the LiDAR frame
-// at the scan's end stamp.
+// at the scan's end stamp. The stages run on a ScanBackend (CPU executor or CUDA, chosen by
+// config.device).
 #include <cstdint>
+#include <memory>
 #include <optional>
+#include <string>
 
 #include "farlio/core/config.hpp"
 #include "farlio/core/se3.hpp"
 #include "farlio/core/types.hpp"
 #include "farlio/deskew/scan_motion.hpp"
-#include "farlio/exec/cpu_executor.hpp"
 #include "farlio/map/voxel_map.hpp"
+#include "farlio/pipeline/frame_timings.hpp"
+#include "farlio/pipeline/scan_backend.hpp"
 #include "farlio/registration/adaptive_threshold.hpp"
 #include "farlio/registration/gicp.hpp"
 
 namespace farlio::pipeline {
-
-/// Wall-clock time of each stage of one frame, in seconds.
-struct FrameTimings {
-  double preprocess_s = 0;   ///< crop, undistortion, downsampling
-  double covariance_s = 0;   ///< frame map and source covariances
-  double registration_s = 0;
-  double map_update_s = 0;   ///< insertion, covariances, removal
-  double total_s = 0;
-};
 
 struct FrameResult {
   std::int64_t stamp_ns = 0;                 ///< scan end stamp
@@ -55,7 +50,8 @@ inline Eigen::Vector3d velocity_from_poses(const SE3& previous, const SE3& curre
 
 class ScanPipeline {
  public:
-  /// `initial_pose`: pose of the LiDAR in the world at the first scan.
+  /// `initial_pose`: pose of the LiDAR in the world at the first scan. Throws when config.device
+  /// is cuda and no CUDA device can be had.
   explicit ScanPipeline(const Config& config, const SE3& initial_pose = SE3());
 
   /// Registers one scan. `initial_guess` (world pose at the scan end) and `motion` (for the
@@ -66,11 +62,14 @@ class ScanPipeline {
   /// Replaces the initial pose; only before the first scan (throws std::logic_error after).
   void reset_initial_pose(const SE3& initial_pose);
 
-  [[nodiscard]] const map::VoxelMap& local_map() const { return map_; }
+  /// The backend that runs the stages (its submap, memory and device).
+  [[nodiscard]] const ScanBackend& backend() const { return *backend_; }
+  [[nodiscard]] ScanBackend& backend() { return *backend_; }
+  /// Why device auto fell back to the CPU (empty when it did not).
+  [[nodiscard]] const std::string& device_message() const { return device_message_; }
   /// The effective parameters (the voxel size is fixed at the first scan when auto).
   [[nodiscard]] const Config& config() const { return config_; }
   [[nodiscard]] std::size_t frames() const { return frames_; }
-  [[nodiscard]] exec::CpuExecutor& executor() { return executor_; }
   /// The constant-velocity prediction for a scan ending at stamp_ns (the LiDAR-only guess).
   [[nodiscard]] SE3 predict(std::int64_t stamp_ns) const;
   /// Body twist per second ([v; w]) between the last two registered poses.
@@ -78,9 +77,8 @@ class ScanPipeline {
 
  private:
   Config config_;
-  exec::CpuExecutor executor_;
-  map::VoxelMap map_;
-  map::VoxelMap frame_map_;
+  std::string device_message_;
+  std::unique_ptr<ScanBackend> backend_;
   registration::AdaptiveThreshold threshold_;
   SE3 initial_pose_;
   SE3 last_pose_, prev_pose_;

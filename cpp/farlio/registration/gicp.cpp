@@ -1,36 +1,12 @@
 #include "farlio/registration/gicp.hpp"
 
 #include <Eigen/Cholesky>
-#include <array>
 #include <chrono>
 #include <cmath>
 
-#include "farlio/registration/gicp_factor.hpp"
+#include "farlio/registration/factor_sums.hpp"
 
 namespace farlio::registration {
-namespace {
-
-constexpr int kHEntries = 21;  // upper triangle of the 6x6 H
-// Accumulator layout: [0, 21) H, [21, 27) b, 27 cost, 28 inliers.
-using Accum = std::array<double, kHEntries + 6 + 2>;
-
-LinearSystem to_system(const Accum& a) {
-  LinearSystem s;
-  int k = 0;
-  for (int i = 0; i < 6; ++i) {
-    for (int j = i; j < 6; ++j) {
-      s.H(i, j) = a[static_cast<std::size_t>(k)];
-      s.H(j, i) = a[static_cast<std::size_t>(k)];
-      ++k;
-    }
-    s.b(i) = a[static_cast<std::size_t>(kHEntries + i)];
-  }
-  s.error = a[kHEntries + 6];
-  s.inliers = static_cast<long>(a[kHEntries + 7]);
-  return s;
-}
-
-}  // namespace
 
 double point_to_point_precision(const RegistrationConfig& config, double covariance_epsilon, double spacing_m) {
   constexpr double kSigmaPerSpacing = 0.5;  // the matched sample may lie up to half a spacing away
@@ -51,9 +27,7 @@ SourceCloud source_from_map(const map::MapView& m, std::size_t voxel_capacity) {
   return src;
 }
 
-LinearSystem build_linear_system(const SourceCloud& source, const map::MapView& target, const SE3& T,
-                                 const Thresholds& th, const RegistrationConfig& config,
-                                 exec::CpuExecutor& executor) {
+FactorParams factor_params(const SE3& T, const Thresholds& th, const RegistrationConfig& config) {
   FactorParams fp;
   fp.R = T.rotation().cast<float>();
   fp.t = T.translation().cast<float>();
@@ -62,37 +36,36 @@ LinearSystem build_linear_system(const SourceCloud& source, const map::MapView& 
   fp.sparsity_aware = config.sparsity_aware;
   fp.skip_line_pairs = config.skip_line_pairs;
   fp.point_to_point_precision = static_cast<float>(th.point_to_point_precision);
-  Accum zero{};
-  const Accum sum = executor.reduce(
-      source.size(), zero,
-      [&](std::size_t i) {
-        Accum a{};
-        FactorTerms f;
-        if (gicp_factor(target, source.points[i], source.covs[i], fp, f)) {
-          for (int k = 0; k < kHEntries; ++k) a[static_cast<std::size_t>(k)] = f.H[k];
-          for (int k = 0; k < 6; ++k) a[static_cast<std::size_t>(kHEntries + k)] = f.b[k];
-          a[kHEntries + 6] = f.cost;
-          a[kHEntries + 7] = 1.0;
-        }
-        return a;
-      },
-      [](Accum a, const Accum& b) {
-        for (std::size_t k = 0; k < a.size(); ++k) a[k] += b[k];
-        return a;
-      });
-  return to_system(sum);
+  return fp;
+}
+
+LinearSystem build_linear_system(const SourceCloud& source, const map::MapView& target, const SE3& T,
+                                 const Thresholds& th, const RegistrationConfig& config,
+                                 exec::CpuExecutor& executor) {
+  const FactorParams fp = factor_params(T, th, config);
+  const FactorSums sum = executor.reduce(
+      source.size(), FactorSums::zero(),
+      [&](std::size_t i) { return factor_sums(target, source.points[i], source.covs[i], fp); }, AddFactorSums{});
+  return to_linear_system(sum);
 }
 
 RegistrationResult register_scan(const SourceCloud& source, const map::MapView& target, const SE3& initial_guess,
                                  const Thresholds& th, const RegistrationConfig& config, double time_budget_s,
                                  exec::CpuExecutor& executor) {
+  return gauss_newton(
+      [&](const SE3& T) { return build_linear_system(source, target, T, th, config, executor); },
+      initial_guess, config, time_budget_s);
+}
+
+RegistrationResult gauss_newton(const SystemBuilder& build, const SE3& initial_guess, const RegistrationConfig& config,
+                                double time_budget_s) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   auto elapsed_s = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
   RegistrationResult res;
   res.pose = initial_guess;
   for (int it = 0; it < config.max_iterations; ++it) {
-    res.system = build_linear_system(source, target, res.pose, th, config, executor);
+    res.system = build(res.pose);
     res.iterations = it + 1;
     if (res.system.inliers == 0) break;  // nothing to register against: not converged
     const Mat6d H = res.system.H + config.damping * Mat6d::Identity();

@@ -3,12 +3,14 @@
 // per-point factors of gicp_factor.hpp, correspondences limited to 3 sigma and the Cauchy
 // kernel scale kappa = sigma / 3 (KISS-ICP's adaptive threshold), stopped when |dx| falls below
 // the convergence norm or the time budget runs out. Returns the pose with the linear system.
+#include <functional>
 #include <vector>
 
 #include "farlio/core/config.hpp"
 #include "farlio/core/se3.hpp"
 #include "farlio/exec/cpu_executor.hpp"
 #include "farlio/map/map_view.hpp"
+#include "farlio/registration/gicp_factor.hpp"
 #include "farlio/registration/linear_system.hpp"
 
 namespace farlio::registration {
@@ -43,6 +45,9 @@ struct Thresholds {
   }
 };
 
+/// The per-factor parameters at pose T (what every backend hands the shared factor body).
+FactorParams factor_params(const SE3& T, const Thresholds& th, const RegistrationConfig& config);
+
 /// The precision of a point-to-point factor in the units of the GICP factors, whose
 /// covariances are Frobenius-normalised so that a surface's normal variance of about
 /// covariance_epsilon (m^2) counts as 1: epsilon / sigma^2, with sigma from
@@ -57,5 +62,13 @@ LinearSystem build_linear_system(const SourceCloud& source, const map::MapView& 
 RegistrationResult register_scan(const SourceCloud& source, const map::MapView& target, const SE3& initial_guess,
                                  const Thresholds& th, const RegistrationConfig& config, double time_budget_s,
                                  exec::CpuExecutor& executor);
+
+/// Builds the linear system of the source at pose T (a backend's reduction).
+using SystemBuilder = std::function<LinearSystem(const SE3&)>;
+
+/// The Gauss-Newton loop on SE(3), whatever backend builds the systems: stops at convergence,
+/// without inliers, or when the time budget is spent.
+RegistrationResult gauss_newton(const SystemBuilder& build, const SE3& initial_guess, const RegistrationConfig& config,
+                                double time_budget_s);
 
 }  // namespace farlio::registration

@@ -13,6 +13,7 @@
 #include <Eigen/LU>
 
 #include "farlio/exec/hd.hpp"
+#include "farlio/exec/hd_math.hpp"
 #include "farlio/map/map_view.hpp"
 #include "farlio/map/neighbor_search.hpp"
 #include "farlio/registration/robust_kernel.hpp"
@@ -54,7 +55,7 @@ FARLIO_HD inline bool gicp_factor(const map::MapView& m, const Eigen::Vector4f& 
   if (fp.sparsity_aware && both_covariances) {
     const Eigen::Matrix3f c = m.covs[nn].matrix() + fp.R * cov_s.matrix() * fp.R.transpose();
     const Eigen::Matrix3f inv = c.inverse();
-    if (inv.allFinite()) omega = inv;
+    if (exec::all_finite(inv)) omega = inv;
   }
   const float r2 = r.squaredNorm();
   const float w = fp.kernel.weight(r2);

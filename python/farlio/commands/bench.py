@@ -6,6 +6,7 @@ import json
 from pathlib import Path
 
 from farlio.benchmark import compare, format_table, generated_scans
+from farlio.runner import DEVICES
 from farlio.datasets import open_dataset
 
 
@@ -16,6 +17,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--data", type=Path, action="append", default=[],
                         help="also a recording (any format farlio run reads; repeatable)")
     parser.add_argument("--threads", type=int, default=0, help="threads for both systems (0: all)")
+    parser.add_argument("--device", choices=DEVICES, default="auto",
+                        help="farlio's backend: auto (the GPU when present, else the CPU with a message), cpu, cuda")
     parser.add_argument("--no-kiss", action="store_true", help="farlio only (KISS-ICP: pip install kiss-icp)")
     parser.add_argument("--out", type=Path, default=None, help="folder for bench.json (optional)")
 
@@ -24,12 +27,13 @@ def run(args: argparse.Namespace) -> int:
     results = {}
     for profile in args.profile or ([] if args.data else ["urban"]):
         scans, gt, _ = generated_scans(profile, args.scans)
-        results[profile] = compare(scans, gt, threads=args.threads, with_kiss=not args.no_kiss)
+        results[profile] = compare(scans, gt, threads=args.threads, with_kiss=not args.no_kiss, device=args.device)
         print(format_table(profile, results[profile]), flush=True)
     for path in args.data:
         ds = open_dataset(path)
         scans = [ds.scan(i) for i in range(min(len(ds), args.scans))]
-        results[str(path)] = compare(scans, None, threads=args.threads, with_kiss=not args.no_kiss)
+        results[str(path)] = compare(scans, None, threads=args.threads, with_kiss=not args.no_kiss,
+                                     device=args.device)
         print(format_table(str(path), results[str(path)]), flush=True)
     if args.out:
         args.out.mkdir(parents=True, exist_ok=True)

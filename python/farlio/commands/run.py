@@ -7,7 +7,7 @@ from pathlib import Path
 from farlio.config import load_config
 from farlio.datasets import FORMAT_HELP, FORMATS, LoadOptions, TimeOptions, open_dataset
 from farlio.datasets.pointcloud2 import HEADER_STAMPS, TIME_FIELDS, TIME_UNITS
-from farlio.runner import format_summary, replay_options, run_dataset
+from farlio.runner import DEVICES, format_summary, replay_options, run_dataset
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -18,6 +18,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                         help="override one config field, e.g. --set map.voxel_size_m=2 (repeatable)")
     parser.add_argument("--threads", type=int, default=None, help="CPU threads (default: all; = num_threads)")
+    parser.add_argument("--device", choices=DEVICES, default=None,
+                        help="scan pipeline backend (= the config field device, default auto): auto takes the GPU "
+                             "when one is present and falls back to the CPU with a message; cuda without one is an error")
     parser.add_argument("--max-frames", type=int, default=None, help="stop after this many scans")
     parser.add_argument("--gt", type=Path, default=None,
                         help="ground-truth body poses (TUM) to evaluate against; a sequence folder's "
@@ -66,6 +69,8 @@ def run(args: argparse.Namespace) -> int:
     overrides = list(args.overrides)
     if args.threads is not None:
         overrides.append(f"num_threads={args.threads}")
+    if args.device is not None:
+        overrides.append(f"device={args.device}")
     config = load_config(args.config, overrides)
     viewer = None
     if args.view:

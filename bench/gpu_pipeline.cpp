@@ -1,0 +1,174 @@
+// Times the whole scan pipeline (undistortion, downsampling, source covariances, GICP, map
+// update) per frame on generated sequences, on the GPU (or the CPU), and prints a short table:
+// median / p99 / max per frame, the device-timed stages, device memory, and the pose agreement
+// with the CPU backend on the same scans; then the effective bandwidth of the k-NN and the GICP
+// reduction against a device-to-device copy. Run by scripts/gpu_check.sh.
+// Usage: gpu_pipeline [--frames N] [--profile urban|racetrack|handheld]... [--device cuda|cpu|auto]
+//                     [--no-cpu-compare] [--repeats R]
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "farlio/pipeline/scan_pipeline.hpp"
+#include "farlio/sim/sequence_generator.hpp"
+#ifdef FARLIO_WITH_CUDA
+#include <cuda_runtime_api.h>
+
+#include "farlio/cuda/cuda_scan_backend.hpp"
+#endif
+
+using namespace farlio;
+
+namespace {
+
+constexpr std::size_t kDefaultFrames = 100;
+constexpr double kFirstScan_s = 2.5;  // generated sequences start at rest for 2 s
+constexpr int kDefaultRepeats = 20;
+constexpr double kMsPerS = 1e3;
+constexpr double kMiB = 1024.0 * 1024.0;
+constexpr double kMedian = 0.5, kP99 = 0.99;
+
+struct Options {
+  std::size_t frames = kDefaultFrames;
+  std::vector<std::string> profiles;
+  Device device = Device::Cuda;
+  bool compare_cpu = true;
+  int repeats = kDefaultRepeats;
+};
+
+Options parse(int argc, char** argv) {
+  Options o;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    const auto value = [&] {
+      if (i + 1 >= argc) throw std::invalid_argument(a + " needs a value");
+      return std::string(argv[++i]);
+    };
+    if (a == "--frames") o.frames = std::stoul(value());
+    else if (a == "--profile") o.profiles.push_back(value());
+    else if (a == "--device") o.device = parse_device(value(), "--device");
+    else if (a == "--no-cpu-compare") o.compare_cpu = false;
+    else if (a == "--repeats") o.repeats = std::stoi(value());
+    else throw std::invalid_argument("unknown option " + a + " (see the comment at the top of bench/gpu_pipeline.cpp)");
+  }
+  if (o.profiles.empty()) o.profiles = {"urban", "racetrack"};
+  return o;
+}
+
+double quantile(std::vector<double> v, double q) {
+  if (v.empty()) return NAN;
+  std::sort(v.begin(), v.end());
+  return v[static_cast<std::size_t>(std::llround(q * static_cast<double>(v.size() - 1)))];
+}
+
+std::vector<Scan> generate(const std::string& profile, std::size_t frames) {
+  sim::SimConfig cfg = sim::default_config(sim::parse_profile(profile));
+  const auto first = static_cast<std::size_t>(std::llround(kFirstScan_s * cfg.lidar_rate_hz));
+  cfg.duration_s = static_cast<double>(first + frames + 1) / cfg.lidar_rate_hz;
+  const sim::SequenceGenerator gen(cfg);
+  std::vector<Scan> scans;
+  for (std::size_t i = first; i < first + frames; ++i) scans.push_back(gen.scan(i));
+  return scans;
+}
+
+/// Device memory in use (bytes), or 0 without CUDA.
+double device_used_bytes() {
+#ifdef FARLIO_WITH_CUDA
+  std::size_t free_b = 0, total_b = 0;
+  if (cudaMemGetInfo(&free_b, &total_b) == cudaSuccess) return static_cast<double>(total_b - free_b);
+#endif
+  return 0.0;
+}
+
+struct Run {
+  std::vector<double> total_ms, stage_ms[4];
+  std::vector<SE3> poses;
+  double prealloc_bytes = 0.0, used_bytes = 0.0;
+  std::size_t max_voxels = 0;
+  bool device_timed = false;
+};
+
+Run run(pipeline::ScanPipeline& p, const std::vector<Scan>& scans, double used_before) {
+  Run r;
+  for (const Scan& s : scans) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto f = p.process(s);
+    r.total_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    const double st[4] = {f.timings.preprocess_s, f.timings.covariance_s, f.timings.registration_s, f.timings.map_update_s};
+    for (int k = 0; k < 4; ++k) r.stage_ms[k].push_back(st[k] * kMsPerS);
+    r.poses.push_back(f.pose);
+    r.max_voxels = std::max(r.max_voxels, f.map_voxels);
+    r.device_timed = f.timings.device_timed;
+  }
+  r.prealloc_bytes = static_cast<double>(p.backend().memory_bytes());
+  r.used_bytes = device_used_bytes() - used_before;
+  return r;
+}
+
+void print_bandwidth(pipeline::ScanPipeline& p, int repeats) {
+#ifdef FARLIO_WITH_CUDA
+  if (p.backend().device() != Device::Cuda) return;
+  const auto samples = cuda::measure_kernel_bandwidth(p.backend(), repeats);
+  const double ceiling = samples.front().gb_per_s();
+  std::printf("  %-22s %10s %12s %10s %10s\n", "kernel", "ms", "MB asked", "GB/s", "of copy");
+  for (const auto& s : samples) {
+    std::printf("  %-22s %10.3f %12.1f %10.1f %9.0f%%\n", s.kernel.c_str(), s.ms, s.bytes / 1e6, s.gb_per_s(),
+                100.0 * s.gb_per_s() / ceiling);
+  }
+#else
+  (void)p;
+  (void)repeats;
+#endif
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    const Options o = parse(argc, argv);
+    resolve_device(o.device);  // cuda without a GPU: the error before anything else
+    std::printf("%-10s %7s %6s %6s %9s %8s %8s | %8s %8s %8s %8s | %9s %9s | %9s %10s | %7s\n", "profile", "points", "device",
+                "frames", "median ms", "p99 ms", "max ms", "prep", "source", "gicp", "update", "prealloc", "used MiB",
+                "dt_max m", "dr_max deg", "voxels");
+    for (const auto& profile : o.profiles) {
+      const std::vector<Scan> scans = generate(profile, o.frames);
+      double points = 0;
+      for (const auto& s : scans) points += static_cast<double>(s.size()) / static_cast<double>(scans.size());
+      Config cfg;
+      cfg.device = o.device;
+      const double used_before = device_used_bytes();  // also creates the CUDA context
+      pipeline::ScanPipeline p(cfg);
+      if (!p.device_message().empty()) std::fprintf(stderr, "%s\n", p.device_message().c_str());
+      const Run r = run(p, scans, used_before);
+      double dt = NAN, dr = NAN;
+      if (o.compare_cpu && p.backend().device() != Device::Cpu) {
+        Config c = cfg;
+        c.device = Device::Cpu;
+        pipeline::ScanPipeline cpu(c);
+        const Run rc = run(cpu, scans, 0.0);
+        dt = dr = 0.0;
+        for (std::size_t i = 0; i < scans.size(); ++i) {
+          const SE3 d = rc.poses[i].inverse() * r.poses[i];
+          dt = std::max(dt, d.translation().norm());
+          dr = std::max(dr, d.angle_rad() * 180.0 / M_PI);
+        }
+      }
+      std::printf("%-10s %7.0f %6s %6zu %9.2f %8.2f %8.2f | %8.2f %8.2f %8.2f %8.2f | %9.1f %9.1f | %9.2e %10.2e | %7zu\n",
+                  profile.c_str(), points, device_name(p.backend().device()), scans.size(), quantile(r.total_ms, kMedian),
+                  quantile(r.total_ms, kP99), quantile(r.total_ms, 1.0), quantile(r.stage_ms[0], kMedian),
+                  quantile(r.stage_ms[1], kMedian), quantile(r.stage_ms[2], kMedian), quantile(r.stage_ms[3], kMedian),
+                  r.prealloc_bytes / kMiB, r.used_bytes / kMiB, dt, dr, r.max_voxels);
+      std::printf("  stages: median ms, %s\n", r.device_timed ? "CUDA events" : "wall clock");
+      print_bandwidth(p, o.repeats);
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "gpu_pipeline: error: %s\n", e.what());
+    return 2;
+  }
+  return 0;
+}

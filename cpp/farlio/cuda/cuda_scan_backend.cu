@@ -1,0 +1,209 @@
+#include "farlio/cuda/cuda_scan_backend.hpp"
+
+#include <algorithm>
+#include <string>
+
+#include "farlio/cuda/cuda_executor.cuh"
+#include "farlio/cuda/device_algorithms.hpp"
+#include "farlio/cuda/device_buffer.hpp"
+#include "farlio/cuda/device_voxel_map.hpp"
+#include "farlio/cuda/map_scratch.hpp"
+#include "farlio/cuda/stage_timer.hpp"
+#include "farlio/map/voxel_update.hpp"
+#include "farlio/pipeline/preprocess_point.hpp"
+#include "farlio/registration/factor_sums.hpp"
+
+namespace farlio::cuda {
+namespace {
+
+constexpr const char* kScanParameter = "cuda.max_scan_points";
+constexpr const char* kMapParameter = "cuda.max_map_voxels";
+constexpr const char* kFrameMapParameter = "cuda.max_frame_voxels";
+/// Bytes of each buffer of the copy ceiling: well beyond the L2 cache of any card.
+constexpr std::size_t kCopyBytes = std::size_t{256} << 20;
+
+std::size_t checked_size(std::int64_t value, const char* name) {
+  if (value <= 0) throw std::invalid_argument(std::string(name) + " must be > 0");
+  return static_cast<std::size_t>(value);
+}
+
+/// Items of the shared work arrays: the largest input of any update, plus one.
+std::size_t scratch_items(const Config& c) {
+  return std::max({checked_size(c.cuda.max_scan_points, kScanParameter), checked_size(c.cuda.max_map_voxels, kMapParameter),
+                   checked_size(c.cuda.max_frame_voxels, kFrameMapParameter)}) + 1;
+}
+
+}  // namespace
+
+class CudaScanBackend final : public pipeline::ScanBackend {
+ public:
+  explicit CudaScanBackend(const Config& config)
+      : config_(config),
+        max_points_(checked_size(config.cuda.max_scan_points, kScanParameter)),
+        algorithms_(scratch_items(config), executor_.stream()),
+        scratch_(scratch_items(config), executor_),
+        map_(config.map, checked_size(config.cuda.max_map_voxels, kMapParameter), kMapParameter, executor_, algorithms_,
+             scratch_),
+        frame_map_(pipeline::frame_map_config(config), checked_size(config.cuda.max_frame_voxels, kFrameMapParameter),
+                   kFrameMapParameter, executor_, algorithms_, scratch_),
+        raw_(max_points_, "scan points"),
+        times_(max_points_, "scan points"),
+        deskewed_(max_points_, "scan points"),
+        frame_(max_points_, "scan points"),
+        world_(max_points_, "scan points"),
+        source_points_(max_points_, "source points"),
+        source_covs_(max_points_, "source points"),
+        timer_(executor_.stream()) {
+    executor_.synchronize();  // the buffers' initialisation has run
+  }
+
+  [[nodiscard]] Device device() const override { return Device::Cuda; }
+
+  void reset(const Config& config) override {
+    config_ = config;
+    map_.reconfigure(config.map);
+    frame_map_.reconfigure(pipeline::frame_map_config(config));
+  }
+
+  std::size_t preprocess(const Scan& scan, const deskew::ScanMotion& motion, bool undistort) override {
+    timer_.new_frame();
+    timer_.start(StageTimer::kPreprocess);
+    const std::size_t n = scan.size();
+    raw_.upload(scan.points.data(), n, executor_.stream(), kScanParameter);
+    if (undistort) times_.upload(scan.time_s.data(), n, executor_.stream(), kScanParameter);
+    frame_size_ = n == 0 ? 0 : downsample(n, motion, undistort);
+    timer_.stop(StageTimer::kPreprocess);
+    return frame_size_;
+  }
+
+  /// Crop, undistortion and the keys of the downsampling cells (one thread a point), then the
+  /// first point of each cell in (cell key, input order), as CpuScanBackend::preprocess.
+  std::size_t downsample(std::size_t n, const deskew::ScanMotion& motion, bool undistort) {
+    const pipeline::PreprocessParams pp{pipeline::RangeCrop::from(config_.preprocess), motion, undistort,
+                                        1.0f / map_.spacing_m()};
+    const Eigen::Vector3f* raw = raw_.data();
+    const float* times = times_.data();
+    Eigen::Vector3f* deskewed = deskewed_.data();
+    std::uint64_t* keys = scratch_.keys.data();
+    executor_.for_each(n, [=] __device__(std::size_t i) {
+      keys[i] = pipeline::preprocess_point(raw[i], undistort ? times[i] : 0.0f, pp, &deskewed[i]);
+    });
+    std::size_t valid = 0;
+    const std::size_t kept = sort_into_groups(scratch_, executor_, algorithms_, n, &valid);
+    const std::int32_t* starts = scratch_.group_start.data();
+    const std::int32_t* order = scratch_.sorted_order.data();
+    Eigen::Vector3f* frame = frame_.data();
+    executor_.for_each(kept, [=] __device__(std::size_t g) { frame[g] = deskewed[order[starts[g]]]; });
+    return kept;
+  }
+
+  pipeline::SourceSummary build_source(double density_range_m) override {
+    timer_.start(StageTimer::kSource);
+    frame_map_.clear();
+    frame_map_.insert(frame_.data(), frame_size_, Eigen::Vector3f::Zero(),
+                      map::PointLimit::constant(config_.density.frame_map_max_points_per_voxel));
+    source_size_ = frame_map_.gather(source_points_.data(), source_covs_.data(), source_points_.capacity(), kScanParameter);
+    pipeline::SourceSummary out{source_size_, frame_map_.mean_points_per_voxel(Eigen::Vector3f::Zero(), density_range_m)};
+    timer_.stop(StageTimer::kSource);
+    return out;
+  }
+
+  registration::RegistrationResult register_source(const SE3& initial_guess, const registration::Thresholds& th,
+                                                   const RegistrationConfig& config, double time_budget_s) override {
+    timer_.start(StageTimer::kRegistration);
+    const auto result = registration::gauss_newton(
+        [&](const SE3& T) { return linear_system(T, th, config); }, initial_guess, config, time_budget_s);
+    timer_.stop(StageTimer::kRegistration);
+    return result;
+  }
+
+  /// One Gauss-Newton system: the shared factor body per source point, reduced with CUB.
+  registration::LinearSystem linear_system(const SE3& T, const registration::Thresholds& th,
+                                           const RegistrationConfig& config) {
+    const registration::FactorParams fp = registration::factor_params(T, th, config);
+    const map::MapView target = map_.view();
+    const Eigen::Vector4f* points = source_points_.data();
+    const map::Cov3* covs = source_covs_.data();
+    const registration::FactorSums sums = executor_.reduce(
+        source_size_, registration::FactorSums::zero(),
+        [=] __device__(std::size_t i) { return registration::factor_sums(target, points[i], covs[i], fp); },
+        registration::AddFactorSums{});
+    return registration::to_linear_system(sums);
+  }
+
+  map::InsertStats update_map(const SE3& pose, const map::PointLimit& limit, std::size_t* removed_voxels) override {
+    timer_.start(StageTimer::kMapUpdate);
+    const Eigen::Matrix3f R = pose.rotation().cast<float>();
+    const Eigen::Vector3f t = pose.translation().cast<float>();
+    const Eigen::Vector3f* frame = frame_.data();
+    Eigen::Vector3f* world = world_.data();
+    executor_.for_each(frame_size_, [=] __device__(std::size_t i) { world[i] = R * frame[i] + t; });
+    const map::InsertStats stats = map_.insert(world_.data(), frame_size_, t, limit);
+    *removed_voxels = map_.remove_far(t);
+    last_pose_ = pose;
+    timer_.stop(StageTimer::kMapUpdate);
+    return stats;
+  }
+
+  [[nodiscard]] std::size_t map_voxels() const override { return map_.num_voxels(); }
+  [[nodiscard]] std::size_t map_points() const override { return map_.num_points(); }
+  [[nodiscard]] map::MapSnapshot map_snapshot() const override { return map_.snapshot(); }
+
+  [[nodiscard]] std::size_t memory_bytes() const override {
+    return executor_.memory_bytes() + algorithms_.memory_bytes() + scratch_.memory_bytes() + map_.memory_bytes() +
+           frame_map_.memory_bytes() + raw_.bytes() + times_.bytes() + deskewed_.bytes() + frame_.bytes() +
+           world_.bytes() + source_points_.bytes() + source_covs_.bytes();
+  }
+
+  bool device_stage_times(pipeline::FrameTimings& t) override {
+    timer_.read(t);
+    return true;
+  }
+
+  std::vector<BandwidthSample> measure_bandwidth(int repeats) {
+    std::vector<BandwidthSample> out{measure_copy(executor_, kCopyBytes, repeats)};
+    const std::size_t n = map_.num_points();
+    DeviceBuffer<Eigen::Vector4f> points(n, "map points");
+    DeviceBuffer<map::Cov3> covs(n, "map points");
+    const std::size_t gathered = map_.gather(points.data(), covs.data(), n, kMapParameter);
+    out.push_back(measure_knn(executor_, map_.view(), points.data(), gathered, config_.map.covariance_neighbors,
+                              map::kUnboundedDistance2, repeats));
+    const auto th = registration::Thresholds::from_sigma(config_.threshold.initial_threshold_m);
+    out.push_back(measure_gicp_reduction(
+        executor_, map_.view(), source_points_.data(), source_covs_.data(), source_size_,
+        static_cast<float>(th.max_correspondence_m * th.max_correspondence_m), last_pose_, repeats));
+    return out;
+  }
+
+ private:
+  Config config_;
+  std::size_t max_points_;
+  CudaExecutor executor_;
+  DeviceAlgorithms algorithms_;
+  MapScratch scratch_;
+  DeviceVoxelMap map_;
+  DeviceVoxelMap frame_map_;
+  DeviceBuffer<Eigen::Vector3f> raw_;
+  DeviceBuffer<float> times_;
+  DeviceBuffer<Eigen::Vector3f> deskewed_;
+  DeviceBuffer<Eigen::Vector3f> frame_;  // the kept points (sensor frame, scan end)
+  DeviceBuffer<Eigen::Vector3f> world_;
+  DeviceBuffer<Eigen::Vector4f> source_points_;
+  DeviceBuffer<map::Cov3> source_covs_;
+  std::size_t frame_size_ = 0;
+  std::size_t source_size_ = 0;
+  SE3 last_pose_;  // of the last map update (the bandwidth measurement's GICP pose)
+  StageTimer timer_;
+};
+
+std::unique_ptr<pipeline::ScanBackend> make_cuda_scan_backend(const Config& config) {
+  return std::make_unique<CudaScanBackend>(config);
+}
+
+std::vector<BandwidthSample> measure_kernel_bandwidth(pipeline::ScanBackend& backend, int repeats) {
+  auto* cuda_backend = dynamic_cast<CudaScanBackend*>(&backend);
+  if (!cuda_backend) throw std::invalid_argument("measure_kernel_bandwidth: the backend is not the CUDA backend");
+  return cuda_backend->measure_bandwidth(repeats);
+}
+
+}  // namespace farlio::cuda

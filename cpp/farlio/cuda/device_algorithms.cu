@@ -1,0 +1,90 @@
+#include "farlio/cuda/device_algorithms.hpp"
+
+#include <cub/device/device_radix_sort.cuh>
+#include <cub/device/device_scan.cuh>
+#include <cub/device/device_select.cuh>
+
+#include <algorithm>
+#include <limits>
+
+namespace farlio::cuda {
+namespace {
+
+std::size_t sort_bytes(std::size_t n) {
+  std::size_t bytes = 0;
+  FARLIO_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, bytes, static_cast<const std::uint64_t*>(nullptr),
+                                                    static_cast<std::uint64_t*>(nullptr),
+                                                    static_cast<const std::int32_t*>(nullptr),
+                                                    static_cast<std::int32_t*>(nullptr), static_cast<int>(n)));
+  return bytes;
+}
+
+std::size_t select_bytes(std::size_t n) {
+  std::size_t bytes = 0;
+  FARLIO_CUDA_CHECK(cub::DeviceSelect::Flagged(nullptr, bytes, static_cast<const std::int32_t*>(nullptr),
+                                               static_cast<const std::uint8_t*>(nullptr),
+                                               static_cast<std::int32_t*>(nullptr), static_cast<std::int32_t*>(nullptr),
+                                               static_cast<int>(n)));
+  return bytes;
+}
+
+std::size_t scan_bytes(std::size_t n) {
+  std::size_t bytes = 0;
+  FARLIO_CUDA_CHECK(cub::DeviceScan::ExclusiveSum(nullptr, bytes, static_cast<const std::int32_t*>(nullptr),
+                                                  static_cast<std::int32_t*>(nullptr), static_cast<int>(n)));
+  return bytes;
+}
+
+std::size_t temp_bytes_for(std::size_t max_items) {
+  if (max_items >= static_cast<std::size_t>(std::numeric_limits<int>::max())) {
+    throw CapacityError("CUDA backend: " + std::to_string(max_items) + " items exceed the 2^31 limit of one sort");
+  }
+  return std::max({sort_bytes(max_items), select_bytes(max_items), scan_bytes(max_items), std::size_t{1}});
+}
+
+}  // namespace
+
+DeviceAlgorithms::DeviceAlgorithms(std::size_t max_items, cudaStream_t stream)
+    : max_items_(max_items),
+      stream_(stream),
+      temp_(temp_bytes_for(max_items), "temporary bytes of CUB"),
+      count_(1, "selected counts") {}
+
+void DeviceAlgorithms::require(std::size_t n, std::size_t temp_bytes) const {
+  if (n > max_items_) {
+    throw CapacityError("CUDA backend: " + std::to_string(n) + " items exceed the " + std::to_string(max_items_) +
+                        " the device buffers were sized for; raise cuda.max_scan_points");
+  }
+  temp_.require(temp_bytes, "cuda.max_scan_points");
+}
+
+void DeviceAlgorithms::sort_pairs(const std::uint64_t* keys_in, std::uint64_t* keys_out, const std::int32_t* values_in,
+                                  std::int32_t* values_out, std::size_t n) {
+  if (n == 0) return;
+  std::size_t bytes = sort_bytes(n);
+  require(n, bytes);
+  FARLIO_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp_.data(), bytes, keys_in, keys_out, values_in, values_out,
+                                                    static_cast<int>(n), 0, static_cast<int>(8 * sizeof(std::uint64_t)),
+                                                    stream_));
+}
+
+std::size_t DeviceAlgorithms::select_flagged(const std::int32_t* in, const std::uint8_t* flags, std::int32_t* out,
+                                             std::size_t n) {
+  if (n == 0) return 0;
+  std::size_t bytes = select_bytes(n);
+  require(n, bytes);
+  FARLIO_CUDA_CHECK(
+      cub::DeviceSelect::Flagged(temp_.data(), bytes, in, flags, out, count_.data(), static_cast<int>(n), stream_));
+  std::int32_t count = 0;
+  count_.download(&count, 1, stream_);
+  return static_cast<std::size_t>(count);
+}
+
+void DeviceAlgorithms::exclusive_sum(const std::int32_t* in, std::int32_t* out, std::size_t n) {
+  if (n == 0) return;
+  std::size_t bytes = scan_bytes(n);
+  require(n, bytes);
+  FARLIO_CUDA_CHECK(cub::DeviceScan::ExclusiveSum(temp_.data(), bytes, in, out, static_cast<int>(n), stream_));
+}
+
+}  // namespace farlio::cuda

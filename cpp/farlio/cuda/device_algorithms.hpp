@@ -1,0 +1,38 @@
+#pragma once
+// The CUB device-wide algorithms the backend needs (radix sort of key/index pairs, stream
+// compaction, exclusive prefix sum) over one temporary buffer sized once for the largest input.
+// Plain C++ header; the calls are in device_algorithms.cu.
+#include <cuda_runtime_api.h>
+
+#include <cstddef>
+#include <cstdint>
+
+#include "farlio/cuda/device_buffer.hpp"
+
+namespace farlio::cuda {
+
+class DeviceAlgorithms {
+ public:
+  /// Temporary storage for inputs of up to max_items items (< 2^31).
+  DeviceAlgorithms(std::size_t max_items, cudaStream_t stream);
+
+  /// Sorts (key, value) pairs by key, stably: with values 0..n-1 the order is (key, index).
+  void sort_pairs(const std::uint64_t* keys_in, std::uint64_t* keys_out, const std::int32_t* values_in,
+                  std::int32_t* values_out, std::size_t n);
+  /// out[0, count) = the in[i] whose flags[i] != 0, in order; returns count (waits for it).
+  std::size_t select_flagged(const std::int32_t* in, const std::uint8_t* flags, std::int32_t* out, std::size_t n);
+  /// out[i] = in[0] + ... + in[i - 1], out[0] = 0.
+  void exclusive_sum(const std::int32_t* in, std::int32_t* out, std::size_t n);
+
+  [[nodiscard]] std::size_t memory_bytes() const { return temp_.bytes() + count_.bytes(); }
+
+ private:
+  void require(std::size_t n, std::size_t temp_bytes) const;
+
+  std::size_t max_items_;
+  cudaStream_t stream_;
+  DeviceBuffer<unsigned char> temp_;
+  DeviceBuffer<std::int32_t> count_;
+};
+
+}  // namespace farlio::cuda

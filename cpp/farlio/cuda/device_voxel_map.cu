@@ -1,0 +1,365 @@
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "farlio/cuda/cuda_executor.cuh"
+#include "farlio/cuda/device_voxel_map.hpp"
+#include "farlio/map/voxel_update.hpp"
+
+namespace farlio::cuda {
+namespace {
+
+/// Sums over the voxel groups of one insertion.
+struct InsertTotals {
+  long long inserted = 0, spacing = 0, full = 0, covariances = 0, table_full = 0;
+  __host__ __device__ InsertTotals& operator+=(const InsertTotals& o) {
+    inserted += o.inserted;
+    spacing += o.spacing;
+    full += o.full;
+    covariances += o.covariances;
+    table_full += o.table_full;
+    return *this;
+  }
+};
+
+struct VoxelTotals {
+  long long voxels = 0, points = 0;
+  __host__ __device__ VoxelTotals& operator+=(const VoxelTotals& o) {
+    voxels += o.voxels;
+    points += o.points;
+    return *this;
+  }
+};
+
+std::int32_t read_scalar(const std::int32_t* device_value, cudaStream_t stream) {
+  std::int32_t v = 0;
+  FARLIO_CUDA_CHECK(cudaMemcpyAsync(&v, device_value, sizeof(v), cudaMemcpyDeviceToHost, stream));
+  FARLIO_CUDA_CHECK(cudaStreamSynchronize(stream));
+  return v;
+}
+
+}  // namespace
+
+DeviceVoxelMap::DeviceVoxelMap(const VoxelMapConfig& config, std::size_t voxel_capacity, std::string capacity_parameter,
+                               CudaExecutor& executor, DeviceAlgorithms& algorithms, MapScratch& scratch)
+    : config_(config),
+      capacity_(voxel_capacity),
+      capacity_parameter_(std::move(capacity_parameter)),
+      executor_(&executor),
+      algorithms_(&algorithms),
+      scratch_(&scratch),
+      spacing_m_(static_cast<float>(map::point_spacing_m(config))),
+      slot_keys_(map::table_capacity_for(voxel_capacity), "table slots"),
+      slot_voxels_(map::table_capacity_for(voxel_capacity), "table slots"),
+      voxel_keys_(voxel_capacity, "voxels"),
+      voxel_counts_(voxel_capacity, "voxels"),
+      points_(voxel_capacity * static_cast<std::size_t>(config.max_points_per_voxel), "map points"),
+      covs_(voxel_capacity * static_cast<std::size_t>(config.max_points_per_voxel), "map points"),
+      free_voxels_(voxel_capacity, "voxels") {
+  map::validate_map_config(config);
+  if (voxel_capacity == 0 || voxel_capacity >= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max())) {
+    throw CapacityError("CUDA backend: " + capacity_parameter_ + " must be in [1, 2^31)");
+  }
+  scratch.keys.require(voxel_capacity + 1, "cuda.max_scan_points");  // the scratch serves removals too
+  high_water_ = capacity_;  // so that clear() empties the whole pool once: empty keys, no points
+  clear();
+}
+
+void DeviceVoxelMap::reconfigure(const VoxelMapConfig& config) {
+  if (config.max_points_per_voxel != config_.max_points_per_voxel) {
+    throw std::invalid_argument("DeviceVoxelMap::reconfigure: max_points_per_voxel cannot change (buffers are preallocated)");
+  }
+  map::validate_map_config(config);
+  config_ = config;
+  spacing_m_ = static_cast<float>(map::point_spacing_m(config));
+  clear();
+}
+
+map::MapView DeviceVoxelMap::view() const {
+  map::MapView v;
+  v.slot_keys = slot_keys_.data();
+  v.slot_voxels = slot_voxels_.data();
+  v.table_capacity = slot_keys_.capacity();
+  v.voxel_keys = voxel_keys_.data();
+  v.voxel_counts = voxel_counts_.data();
+  v.points = points_.data();
+  v.covs = covs_.data();
+  v.max_points_per_voxel = config_.max_points_per_voxel;
+  v.voxel_size = static_cast<float>(config_.voxel_size_m);
+  v.inv_voxel_size = static_cast<float>(1.0 / config_.voxel_size_m);
+  return v;
+}
+
+void DeviceVoxelMap::clear() {
+  const cudaStream_t s = executor_->stream();
+  FARLIO_CUDA_CHECK(cudaMemsetAsync(slot_keys_.data(), 0xFF, slot_keys_.bytes(), s));  // all kEmptyKey
+  FARLIO_CUDA_CHECK(cudaMemsetAsync(voxel_keys_.data(), 0xFF, high_water_ * sizeof(std::uint64_t), s));
+  FARLIO_CUDA_CHECK(cudaMemsetAsync(voxel_counts_.data(), 0, high_water_ * sizeof(std::int32_t), s));
+  free_count_ = high_water_ = live_voxels_ = used_slots_ = 0;
+}
+
+void DeviceVoxelMap::rehash() {
+  FARLIO_CUDA_CHECK(cudaMemsetAsync(slot_keys_.data(), 0xFF, slot_keys_.bytes(), executor_->stream()));
+  FARLIO_CUDA_CHECK(cudaMemsetAsync(scratch_->scalars.data(), 0, scratch_->scalars.bytes(), executor_->stream()));
+  const map::MapView v = view();
+  std::int32_t* table_full = scratch_->scalars.data() + kScalarTableFull;
+  executor_->for_each(high_water_, [=] __device__(std::size_t i) {
+    const std::uint64_t key = v.voxel_keys[i];
+    if (key == map::kEmptyKey) return;
+    if (map::table_insert(v, key, map::spatial_hash(map::unpack_key(key)), static_cast<std::int32_t>(i)) < 0) {
+      exec::atomic_add(table_full, 1);
+    }
+  });
+  if (read_scalar(table_full, executor_->stream()) > 0) {
+    throw CapacityError("CUDA backend: the voxel table is full while rehashing; raise " + capacity_parameter_);
+  }
+  used_slots_ = live_voxels_;
+}
+
+map::InsertStats DeviceVoxelMap::insert(const Eigen::Vector3f* points, std::size_t n, const Eigen::Vector3f& origin,
+                                        const map::PointLimit& limit) {
+  map::InsertStats stats;
+  stats.candidates = n;
+  if (n == 0) return stats;
+  MapScratch& s = *scratch_;
+  CudaExecutor& ex = *executor_;
+  s.keys.require(n + 1, "cuda.max_scan_points");
+
+  // 1. group the candidates by voxel, in input order inside a voxel
+  const float inv_voxel = static_cast<float>(1.0 / config_.voxel_size_m);
+  std::uint64_t* keys = s.keys.data();
+  ex.for_each(n, [=] __device__(std::size_t i) { keys[i] = map::point_key(points[i], inv_voxel); });
+  std::size_t valid = 0;
+  const std::size_t groups = sort_into_groups(s, ex, *algorithms_, n, &valid);
+  stats.out_of_range = n - valid;
+  if (groups == 0) return stats;
+
+  // 2. find existing voxels; new ones are numbered in key order (exclusive sum of the misses)
+  const map::MapView v = view();
+  const std::uint64_t* sorted_keys = s.sorted_keys.data();
+  const std::int32_t* group_start = s.group_start.data();
+  std::int32_t* group_voxel = s.group_voxel.data();
+  std::int32_t* missing = s.missing.data();
+  std::int32_t* rank = s.rank.data();
+  ex.for_each(groups, [=] __device__(std::size_t g) {
+    const std::uint64_t key = sorted_keys[group_start[g]];
+    const std::int32_t vox = map::table_find(v, key, map::spatial_hash(map::unpack_key(key)));
+    group_voxel[g] = vox;
+    missing[g] = vox < 0 ? 1 : 0;
+    if (g == 0) missing[groups] = 0;  // one more element: rank[groups] is the number of misses
+  });
+  algorithms_->exclusive_sum(missing, rank, groups + 1);
+  const auto new_voxels = static_cast<std::size_t>(read_scalar(rank + groups, ex.stream()));
+  FARLIO_CUDA_CHECK(cudaMemsetAsync(s.scalars.data(), 0, s.scalars.bytes(), ex.stream()));
+  std::int32_t* table_full = s.scalars.data() + kScalarTableFull;
+  if (new_voxels > 0) {
+    const std::size_t from_pool = std::min(new_voxels, free_count_);
+    const std::size_t needed = high_water_ + (new_voxels - from_pool);
+    if (needed > capacity_) {
+      throw CapacityError("voxel map on the device is full: " + std::to_string(needed) + " voxels needed, " +
+                          capacity_parameter_ + " is " + std::to_string(capacity_) +
+                          "; raise it or lower map.removal_radius_m");
+    }
+    if (static_cast<double>(used_slots_ + new_voxels) > static_cast<double>(slot_keys_.capacity()) / map::kSlotsPerVoxel) {
+      rehash();
+    }
+    // the CPU's allocation order: free voxels from the back of the list, then the high-water mark
+    const std::int32_t* free_list = free_voxels_.data();
+    const auto pool = static_cast<std::int32_t>(from_pool);
+    const auto free_top = static_cast<std::int32_t>(free_count_);
+    const auto hw = static_cast<std::int32_t>(high_water_);
+    ex.for_each(groups, [=] __device__(std::size_t g) {
+      if (!missing[g]) return;
+      const std::int32_t r = rank[g];
+      const std::int32_t vox = r < pool ? free_list[free_top - 1 - r] : hw + (r - pool);
+      const std::uint64_t key = sorted_keys[group_start[g]];
+      v.voxel_keys[vox] = key;
+      v.voxel_counts[vox] = 0;
+      group_voxel[g] = vox;
+      if (map::table_insert(v, key, map::spatial_hash(map::unpack_key(key)), vox) < 0) exec::atomic_add(table_full, 1);
+    });
+    free_count_ -= from_pool;
+    high_water_ = needed;
+    live_voxels_ += new_voxels;
+    used_slots_ += new_voxels;
+    stats.new_voxels = new_voxels;
+  }
+
+  // 3. insert each voxel's candidates in order, with the cap and the spacing (one thread a voxel)
+  const map::InsertParams ip{origin, limit, spacing_m_ * spacing_m_};
+  const std::int32_t* order = s.sorted_order.data();
+  std::int32_t* first_new = s.first_new.data();
+  map::GroupStats* gstats = s.group_stats.data();
+  ex.for_each(groups, [=] __device__(std::size_t g) {
+    const auto candidate = [=](std::int64_t c) { return points[order[c]]; };
+    gstats[g] = map::insert_voxel_group(v, group_voxel[g], candidate, group_start[g], group_start[g + 1], ip,
+                                        &first_new[g]);
+  });
+  const bool refresh = config_.refresh_covariances;
+  const InsertTotals totals = ex.reduce(
+      groups, InsertTotals{},
+      [=] __device__(std::size_t g) {
+        InsertTotals t;
+        t.inserted = gstats[g].inserted;
+        t.spacing = gstats[g].spacing;
+        t.full = gstats[g].full;
+        const std::int32_t count = v.voxel_counts[group_voxel[g]];
+        if (count != first_new[g]) t.covariances = count - (refresh ? 0 : first_new[g]);
+        if (g == 0) t.table_full = *table_full;
+        return t;
+      },
+      Add{});
+  if (totals.table_full > 0) {
+    throw CapacityError("CUDA backend: the voxel table is full; raise " + capacity_parameter_);
+  }
+  stats.inserted = static_cast<std::size_t>(totals.inserted);
+  stats.rejected_spacing = static_cast<std::size_t>(totals.spacing);
+  stats.rejected_full = static_cast<std::size_t>(totals.full);
+  stats.covariances_computed = static_cast<std::size_t>(totals.covariances);
+
+  // 4. covariances of the new points (or of every point of a changed voxel): one thread a point
+  //    slot of each group's voxel (the CPU runs the same body in a loop, one task a voxel)
+  if (totals.covariances > 0) {
+    const int k = config_.covariance_neighbors;
+    const auto eps = static_cast<float>(config_.covariance_epsilon);
+    const auto line_ratio = static_cast<float>(config_.line_eigenvalue_ratio);
+    const auto slots = static_cast<std::size_t>(config_.max_points_per_voxel);
+    ex.for_each(groups * slots, [=] __device__(std::size_t i) {
+      const std::size_t g = i / slots;
+      const auto j = static_cast<std::int32_t>(i % slots);
+      const std::int32_t vox = group_voxel[g];
+      const std::int32_t count = v.voxel_counts[vox];
+      if (count == first_new[g] || j < (refresh ? 0 : first_new[g]) || j >= count) return;
+      map::update_point_covariance(v, vox, j, k, eps, line_ratio);
+    });
+  }
+  return stats;
+}
+
+std::size_t DeviceVoxelMap::remove_far(const Eigen::Vector3f& origin) {
+  if (high_water_ == 0 || !std::isfinite(config_.removal_radius_m)) return 0;
+  const double r2 = config_.removal_radius_m * config_.removal_radius_m;
+  const double vs = config_.voxel_size_m;
+  const Eigen::Vector3d o = origin.cast<double>();
+  const map::MapView v = view();
+  std::uint8_t* flags = scratch_->flags.data();
+  executor_->for_each(high_water_, [=] __device__(std::size_t i) {
+    const std::uint64_t key = v.voxel_keys[i];
+    const bool far = key != map::kEmptyKey && map::voxel_centre_distance2(key, o, vs) > r2;
+    flags[i] = far;
+    if (!far) return;
+    map::table_erase(v, key, map::spatial_hash(map::unpack_key(key)));
+    v.voxel_keys[i] = map::kEmptyKey;
+    v.voxel_counts[i] = 0;
+  });
+  // freed voxels join the free list in increasing order, as on the CPU
+  const std::size_t removed =
+      algorithms_->select_flagged(scratch_->iota.data(), flags, free_voxels_.data() + free_count_, high_water_);
+  free_count_ += removed;
+  live_voxels_ -= removed;
+  if (static_cast<double>(used_slots_ - live_voxels_) > map::kMaxErasedFraction * static_cast<double>(slot_keys_.capacity())) {
+    rehash();
+  }
+  return removed;
+}
+
+double DeviceVoxelMap::mean_points_per_voxel(const Eigen::Vector3f& origin, double range_m) const {
+  const map::MapView v = view();
+  const double vs = config_.voxel_size_m;
+  const Eigen::Vector3d o = origin.cast<double>();
+  const VoxelTotals t = executor_->reduce(
+      high_water_, VoxelTotals{},
+      [=] __device__(std::size_t i) {
+        VoxelTotals r;
+        const std::uint64_t key = v.voxel_keys[i];
+        if (key == map::kEmptyKey || sqrt(map::voxel_centre_distance2(key, o, vs)) > range_m) return r;
+        r.voxels = 1;
+        r.points = v.voxel_counts[i];
+        return r;
+      },
+      Add{});
+  return t.voxels ? static_cast<double>(t.points) / static_cast<double>(t.voxels) : 0.0;
+}
+
+std::size_t DeviceVoxelMap::num_points() const {
+  const std::int32_t* counts = voxel_counts_.data();
+  return static_cast<std::size_t>(executor_->reduce(
+      high_water_, 0LL, [=] __device__(std::size_t i) { return static_cast<long long>(counts[i]); }, Add{}));
+}
+
+std::size_t DeviceVoxelMap::gather(Eigen::Vector4f* out_points, map::Cov3* out_covs, std::size_t capacity,
+                                   const char* parameter) {
+  if (high_water_ == 0) return 0;
+  const map::MapView v = view();
+  std::int32_t* counts = scratch_->missing.data();
+  std::int32_t* offsets = scratch_->rank.data();
+  const std::size_t hw = high_water_;
+  executor_->for_each(hw + 1, [=] __device__(std::size_t i) { counts[i] = i < hw ? v.voxel_counts[i] : 0; });
+  algorithms_->exclusive_sum(counts, offsets, hw + 1);
+  const auto total = static_cast<std::size_t>(read_scalar(offsets + hw, executor_->stream()));
+  if (total > capacity) {
+    throw CapacityError("CUDA backend: " + std::to_string(total) + " source points exceed the device buffer of " +
+                        std::to_string(capacity) + "; raise " + parameter);
+  }
+  executor_->for_each(hw, [=] __device__(std::size_t i) {
+    const auto vox = static_cast<std::int32_t>(i);
+    for (std::int32_t j = 0; j < v.voxel_counts[i]; ++j) {
+      out_points[offsets[i] + j] = v.points[v.point_index(vox, j)];
+      out_covs[offsets[i] + j] = v.covs[v.point_index(vox, j)];
+    }
+  });
+  return total;
+}
+
+std::size_t DeviceVoxelMap::memory_bytes() const {
+  return slot_keys_.bytes() + slot_voxels_.bytes() + voxel_keys_.bytes() + voxel_counts_.bytes() + points_.bytes() +
+         covs_.bytes() + free_voxels_.bytes();
+}
+
+map::MapSnapshot DeviceVoxelMap::snapshot() const {
+  const auto n = static_cast<std::size_t>(config_.max_points_per_voxel);
+  map::MapSnapshot s;
+  s.max_points_per_voxel = config_.max_points_per_voxel;
+  s.voxel_keys.resize(high_water_);
+  s.voxel_counts.resize(high_water_);
+  s.points.resize(high_water_ * n);
+  s.covs.resize(high_water_ * n);
+  const cudaStream_t st = executor_->stream();
+  voxel_keys_.download(s.voxel_keys.data(), high_water_, st);
+  voxel_counts_.download(s.voxel_counts.data(), high_water_, st);
+  points_.download(s.points.data(), high_water_ * n, st);
+  covs_.download(s.covs.data(), high_water_ * n, st);
+  return s;
+}
+
+KnnResults DeviceVoxelMap::knn(const std::vector<Eigen::Vector3f>& queries, int k, float max_distance2) const {
+  if (k <= 0 || k > map::kMaxNeighbors) throw std::invalid_argument("knn: k must be in [1, kMaxNeighbors]");
+  const std::size_t nq = queries.size();
+  const auto per = static_cast<std::size_t>(k);
+  KnnResults r;
+  r.k = k;
+  r.found.resize(nq);
+  r.indices.resize(nq * per);
+  r.distances2.resize(nq * per);
+  if (nq == 0) return r;
+  DeviceBuffer<Eigen::Vector3f> q(nq, "queries");
+  DeviceBuffer<int> found(nq, "queries");
+  DeviceBuffer<std::int64_t> idx(nq * per, "queries");
+  DeviceBuffer<float> d2(nq * per, "queries");
+  const cudaStream_t st = executor_->stream();
+  q.upload(queries.data(), nq, st, "(queries)");
+  const map::MapView v = view();
+  const Eigen::Vector3f* qp = q.data();
+  int* fp = found.data();
+  std::int64_t* ip = idx.data();
+  float* dp = d2.data();
+  executor_->for_each(nq, [=] __device__(std::size_t i) {
+    fp[i] = map::knn_search(v, qp[i], k, max_distance2, ip + i * per, dp + i * per);
+  });
+  found.download(r.found.data(), nq, st);
+  idx.download(r.indices.data(), nq * per, st);
+  d2.download(r.distances2.data(), nq * per, st);
+  return r;
+}
+
+}  // namespace farlio::cuda

@@ -1,0 +1,65 @@
+#include "farlio/cuda/cuda_executor.cuh"
+#include "farlio/cuda/map_scratch.hpp"
+
+namespace farlio::cuda {
+namespace {
+
+// (a free function: a constructor cannot enclose a __device__ lambda)
+void fill_iota(CudaExecutor& executor, std::int32_t* out, std::size_t n) {
+  executor.for_each(n, [=] __device__(std::size_t i) { out[i] = static_cast<std::int32_t>(i); });
+}
+
+}  // namespace
+
+MapScratch::MapScratch(std::size_t n, CudaExecutor& executor)
+    : items(n),
+      keys(n, "keys"),
+      sorted_keys(n, "keys"),
+      iota(n, "keys"),
+      sorted_order(n, "keys"),
+      flags(n, "keys"),
+      group_start(n, "keys"),
+      group_voxel(n, "keys"),
+      missing(n, "keys"),
+      rank(n, "keys"),
+      first_new(n, "keys"),
+      group_stats(n, "keys"),
+      scalars(kScalarCount, "scalars") {
+  fill_iota(executor, iota.data(), n);
+}
+
+std::size_t MapScratch::memory_bytes() const {
+  return keys.bytes() + sorted_keys.bytes() + iota.bytes() + sorted_order.bytes() + flags.bytes() +
+         group_start.bytes() + group_voxel.bytes() + missing.bytes() + rank.bytes() + first_new.bytes() +
+         group_stats.bytes() + scalars.bytes();
+}
+
+std::size_t sort_into_groups(MapScratch& s, CudaExecutor& ex, DeviceAlgorithms& alg, std::size_t n,
+                             std::size_t* valid) {
+  *valid = 0;
+  if (n == 0) return 0;
+  s.keys.require(n + 1, "cuda.max_scan_points");  // + 1: the end of the last group
+  alg.sort_pairs(s.keys.data(), s.sorted_keys.data(), s.iota.data(), s.sorted_order.data(), n);
+  const std::uint64_t* keys = s.sorted_keys.data();
+  std::uint8_t* flags = s.flags.data();
+  std::int32_t* scalars = s.scalars.data();
+  ex.for_each(n, [=] __device__(std::size_t i) {
+    const std::uint64_t k = keys[i];
+    const bool empty = k == map::kEmptyKey;
+    flags[i] = !empty && (i == 0 || k != keys[i - 1]);
+    // exactly one thread writes where the valid keys end (empty keys sort last)
+    if (empty && (i == 0 || keys[i - 1] != map::kEmptyKey)) scalars[kScalarFirstEmpty] = static_cast<std::int32_t>(i);
+    if (!empty && i == n - 1) scalars[kScalarFirstEmpty] = static_cast<std::int32_t>(n);
+  });
+  const std::size_t groups = alg.select_flagged(s.iota.data(), flags, s.group_start.data(), n);
+  std::int32_t first_empty = 0;
+  FARLIO_CUDA_CHECK(cudaMemcpyAsync(&first_empty, scalars + kScalarFirstEmpty, sizeof(first_empty),
+                                    cudaMemcpyDeviceToHost, ex.stream()));
+  ex.synchronize();
+  *valid = static_cast<std::size_t>(first_empty);
+  std::int32_t* starts = s.group_start.data();
+  ex.for_each(1, [=] __device__(std::size_t) { starts[groups] = first_empty; });
+  return groups;
+}
+
+}  // namespace farlio::cuda

@@ -1,0 +1,43 @@
+#pragma once
+// The work arrays of one update (a map insertion, a removal, a downsampling), shared by the
+// maps of one backend since its stages run one after the other on one stream. Sized once for
+// the largest input: max(scan points, map voxels) + 1.
+#include <cstddef>
+#include <cstdint>
+
+#include "farlio/cuda/cuda_executor.hpp"
+#include "farlio/cuda/device_algorithms.hpp"
+#include "farlio/cuda/device_buffer.hpp"
+#include "farlio/map/voxel_update.hpp"
+
+namespace farlio::cuda {
+
+struct MapScratch {
+  explicit MapScratch(std::size_t items, CudaExecutor& executor);
+
+  std::size_t items;
+  DeviceBuffer<std::uint64_t> keys, sorted_keys;
+  DeviceBuffer<std::int32_t> iota;          ///< 0, 1, 2, ... (filled once)
+  DeviceBuffer<std::int32_t> sorted_order;  ///< input index of each sorted key
+  DeviceBuffer<std::uint8_t> flags;
+  DeviceBuffer<std::int32_t> group_start;   ///< sorted position of each group's first key, then the end
+  DeviceBuffer<std::int32_t> group_voxel, missing, rank, first_new;
+  DeviceBuffer<map::GroupStats> group_stats;
+  DeviceBuffer<std::int32_t> scalars;       ///< small device-side results (see map_scratch.cu)
+
+  [[nodiscard]] std::size_t memory_bytes() const;
+};
+
+/// Positions of scalars.
+inline constexpr int kScalarFirstEmpty = 0;  ///< sorted position of the first kEmptyKey (or n)
+inline constexpr int kScalarTableFull = 1;   ///< failed table insertions
+inline constexpr int kScalarCount = 2;
+
+/// Sorts scratch.keys[0, n) with their indices (order: key, then index) and finds the groups of
+/// equal keys, kEmptyKey excluded: group g starts at sorted position group_start[g] and ends at
+/// group_start[g + 1] (written too). Returns the number of groups; *valid receives the number of
+/// keys that are not kEmptyKey.
+std::size_t sort_into_groups(MapScratch& scratch, CudaExecutor& executor, DeviceAlgorithms& algorithms, std::size_t n,
+                             std::size_t* valid);
+
+}  // namespace farlio::cuda

@@ -1,0 +1,112 @@
+#pragma once
+// The per-voxel bodies of the map update, shared by the CPU executor (VoxelMap) and the CUDA
+// backend: the key of a candidate point, the insertion of one voxel's candidates in their
+// input order (cap and minimum spacing), the covariances of a voxel's points, and the voxel
+// centre tests of removal and density. Both backends group the candidates by voxel the same
+// way (sorted by key, then input order) and run one body per voxel, so they store the same
+// points in the same order.
+#include <Eigen/Core>
+#include <cstdint>
+#include <limits>
+
+#include "farlio/exec/hd.hpp"
+#include "farlio/exec/hd_math.hpp"
+#include "farlio/map/covariance.hpp"
+#include "farlio/map/map_view.hpp"
+#include "farlio/map/neighbor_search.hpp"
+#include "farlio/map/point_limit.hpp"
+#include "farlio/map/voxel_key.hpp"
+
+namespace farlio::map {
+
+/// The packed key of the voxel (or downsampling cell) of p, or kEmptyKey when p is not finite
+/// or outside the key range: such points sort last and are dropped.
+FARLIO_HD inline std::uint64_t point_key(const Eigen::Vector3f& p, float inv_cell_size) {
+  if (!exec::all_finite(p)) return kEmptyKey;
+  const VoxelCoord c = voxel_of(p, inv_cell_size);
+  return in_key_range(c) ? pack_key(c) : kEmptyKey;
+}
+
+/// What happened to one voxel's candidates.
+struct GroupStats {
+  std::int32_t inserted = 0, spacing = 0, full = 0;
+};
+
+struct InsertParams {
+  Eigen::Vector3f origin;  ///< the sensor position (the limit depends on the distance to it)
+  PointLimit limit;
+  float spacing2;          ///< squared minimum distance between points of a voxel
+};
+
+/// Inserts the candidates candidate(c), c in [begin, end), into `voxel` in that order: a
+/// candidate is stored unless the voxel holds its limit or a stored point is closer than the
+/// spacing. `*first_new` receives the voxel's count before the insertion.
+template <typename Candidate>
+FARLIO_HD GroupStats insert_voxel_group(const MapView& m, std::int32_t voxel, const Candidate& candidate,
+                                        std::int64_t begin, std::int64_t end, const InsertParams& ip,
+                                        std::int32_t* first_new) {
+  GroupStats s;
+  std::int32_t count = m.voxel_counts[voxel];
+  *first_new = count;
+  for (std::int64_t c = begin; c < end; ++c) {
+    const Eigen::Vector3f p = candidate(c);
+    const int lim = ip.limit.at((p - ip.origin).norm());
+    if (count >= (lim < m.max_points_per_voxel ? lim : m.max_points_per_voxel)) {
+      ++s.full;
+      continue;
+    }
+    bool too_close = false;
+    for (std::int32_t j = 0; j < count && !too_close; ++j) {
+      too_close = (m.points[m.point_index(voxel, j)].head<3>() - p).squaredNorm() < ip.spacing2;
+    }
+    if (too_close) {
+      ++s.spacing;
+      continue;
+    }
+    m.points[m.point_index(voxel, count)] = Eigen::Vector4f(p.x(), p.y(), p.z(), 0.0f);
+    ++count;
+    ++s.inserted;
+  }
+  m.voxel_counts[voxel] = count;
+  return s;
+}
+
+/// No distance limit for the covariance neighbours (the 27 voxels bound them).
+inline constexpr float kUnboundedDistance2 = std::numeric_limits<float>::max();
+
+/// Covariance (eq. 1) of point j of `voxel` from its k nearest neighbours, and its shape in w
+/// (map::PointShape: no covariance with fewer than k neighbours, else surface or line by
+/// `line_ratio`). Reads the points of the 27 voxels around it.
+FARLIO_HD inline void update_point_covariance(const MapView& m, std::int32_t voxel, std::int32_t j, int k, float epsilon,
+                                              float line_ratio) {
+  std::int64_t idx[kMaxNeighbors];
+  float d2[kMaxNeighbors];
+  const std::int64_t pi = m.point_index(voxel, j);
+  const Eigen::Vector3f p = m.points[pi].head<3>();
+  const int found = knn_search(m, p, k, kUnboundedDistance2, idx, d2);
+  if (found < k) {
+    m.points[pi].w() = shape_code(PointShape::NoCovariance);
+    return;
+  }
+  CovarianceAccumulator acc(p);
+  for (int n = 0; n < found; ++n) acc.add(m.points[idx[n]].head<3>());
+  const Eigen::Matrix3f cov = regularize_frobenius(acc.covariance(), epsilon);
+  m.covs[pi] = Cov3::from(cov);
+  m.points[pi].w() = shape_code(classify_shape(cov, line_ratio));
+}
+
+/// Covariances of the points [first, count) of `voxel` (one CPU task a voxel).
+FARLIO_HD inline void update_voxel_covariances(const MapView& m, std::int32_t voxel, std::int32_t first, int k,
+                                               float epsilon, float line_ratio) {
+  const std::int32_t count = m.voxel_counts[voxel];
+  for (std::int32_t j = first; j < count; ++j) update_point_covariance(m, voxel, j, k, epsilon, line_ratio);
+}
+
+/// Squared distance (double) from `origin` to the centre of the voxel with this key.
+FARLIO_HD inline double voxel_centre_distance2(std::uint64_t key, const Eigen::Vector3d& origin, double voxel_size) {
+  const VoxelCoord c = unpack_key(key);
+  const Eigen::Vector3d centre = (c.cast<double>() + Eigen::Vector3d::Constant(0.5)) * voxel_size;
+  return (centre - origin).squaredNorm();
+}
+
+}  // namespace farlio::map

@@ -1,0 +1,60 @@
+#include "farlio/pipeline/cpu_scan_backend.hpp"
+
+#include "farlio/pipeline/preprocess.hpp"
+#include "farlio/pipeline/preprocess_point.hpp"
+
+namespace farlio::pipeline {
+
+CpuScanBackend::CpuScanBackend(const Config& config)
+    : config_(config),
+      executor_(config.num_threads),
+      map_(config.map, executor_),
+      frame_map_(frame_map_config(config), executor_) {}
+
+void CpuScanBackend::reset(const Config& config) {
+  config_ = config;
+  map_ = map::VoxelMap(config_.map, executor_);
+  frame_map_ = map::VoxelMap(frame_map_config(config_), executor_);
+}
+
+std::size_t CpuScanBackend::preprocess(const Scan& scan, const deskew::ScanMotion& motion, bool undistort) {
+  const PreprocessParams pp{RangeCrop::from(config_.preprocess), motion, undistort, 1.0f / map_.spacing_m()};
+  const std::size_t n = scan.size();
+  std::vector<Eigen::Vector3f> points(n);
+  std::vector<std::pair<std::uint64_t, std::int32_t>> keyed(n);
+  executor_.for_each(n, [&](std::size_t i) {
+    const float tau = undistort ? scan.time_s[i] : 0.0f;
+    keyed[i] = {preprocess_point(scan.points[i], tau, pp, &points[i]), static_cast<std::int32_t>(i)};
+  });
+  const std::vector<std::int32_t> kept = first_of_each_cell(keyed, executor_);
+  frame_.resize(kept.size());
+  for (std::size_t k = 0; k < kept.size(); ++k) frame_[k] = points[static_cast<std::size_t>(kept[k])];
+  return frame_.size();
+}
+
+SourceSummary CpuScanBackend::build_source(double density_range_m) {
+  frame_map_.clear();
+  frame_map_.insert(frame_, Eigen::Vector3f::Zero(),
+                    map::PointLimit::constant(config_.density.frame_map_max_points_per_voxel));
+  source_ = registration::source_from_map(frame_map_.view(), frame_map_.voxel_capacity());
+  return {source_.size(), frame_map_.mean_points_per_voxel(Eigen::Vector3f::Zero(), density_range_m)};
+}
+
+registration::RegistrationResult CpuScanBackend::register_source(const SE3& initial_guess,
+                                                                 const registration::Thresholds& th,
+                                                                 const RegistrationConfig& config,
+                                                                 double time_budget_s) {
+  return registration::register_scan(source_, map_.view(), initial_guess, th, config, time_budget_s, executor_);
+}
+
+map::InsertStats CpuScanBackend::update_map(const SE3& pose, const map::PointLimit& limit, std::size_t* removed_voxels) {
+  std::vector<Eigen::Vector3f> world(frame_.size());
+  const Eigen::Matrix3f R = pose.rotation().cast<float>();
+  const Eigen::Vector3f t = pose.translation().cast<float>();
+  executor_.for_each(frame_.size(), [&](std::size_t i) { world[i] = R * frame_[i] + t; });
+  const map::InsertStats stats = map_.insert(world, t, limit);
+  *removed_voxels = map_.remove_far(t);
+  return stats;
+}
+
+}  // namespace farlio::pipeline

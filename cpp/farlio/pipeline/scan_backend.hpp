@@ -1,0 +1,69 @@
+#pragma once
+// The compute backend of the scan pipeline: where the scan, the frame map, the source cloud and
+// the submap live and where the per-point bodies run (CPU executor or CUDA). ScanPipeline keeps
+// the logic between the stages (guesses, thresholds, density, velocity) on the host and calls
+// one backend method per stage.
+#include <cstddef>
+#include <memory>
+#include <string>
+
+#include "farlio/core/config.hpp"
+#include "farlio/core/device.hpp"
+#include "farlio/core/se3.hpp"
+#include "farlio/core/types.hpp"
+#include "farlio/deskew/scan_motion.hpp"
+#include "farlio/map/map_snapshot.hpp"
+#include "farlio/map/point_limit.hpp"
+#include "farlio/map/voxel_map.hpp"
+#include "farlio/pipeline/frame_timings.hpp"
+#include "farlio/registration/gicp.hpp"
+
+namespace farlio::pipeline {
+
+/// The source cloud of a frame and the scan's density measured on its frame map.
+struct SourceSummary {
+  std::size_t points = 0;
+  double mean_points_per_voxel = 0.0;  ///< over frame-map voxels within the density range
+};
+
+class ScanBackend {
+ public:
+  virtual ~ScanBackend() = default;
+  [[nodiscard]] virtual Device device() const = 0;
+  /// Empties both maps and takes the map parameters of `config` (the voxel size is fixed at the
+  /// first scan). Allocates nothing on the CUDA backend.
+  virtual void reset(const Config& config) = 0;
+  /// Range crop, undistortion into the scan-end frame (when `undistort`), downsampling to the
+  /// map spacing. Keeps the frame; returns its size.
+  virtual std::size_t preprocess(const Scan& scan, const deskew::ScanMotion& motion, bool undistort) = 0;
+  /// The per-scan frame map of the frame (sensor frame), the source cloud with its covariances,
+  /// and the mean points per frame-map voxel within `density_range_m` of the sensor.
+  virtual SourceSummary build_source(double density_range_m) = 0;
+  /// Sparsity-aware GICP of the source against the submap.
+  virtual registration::RegistrationResult register_source(const SE3& initial_guess, const registration::Thresholds& th,
+                                                           const RegistrationConfig& config, double time_budget_s) = 0;
+  /// Inserts the frame at `pose` into the submap, then removes voxels far from the pose.
+  virtual map::InsertStats update_map(const SE3& pose, const map::PointLimit& limit, std::size_t* removed_voxels) = 0;
+  [[nodiscard]] virtual std::size_t map_voxels() const = 0;
+  [[nodiscard]] virtual std::size_t map_points() const = 0;
+  /// Bytes held for the submap (CPU) or all device buffers (CUDA, preallocated).
+  [[nodiscard]] virtual std::size_t memory_bytes() const = 0;
+  /// A host copy of the submap.
+  [[nodiscard]] virtual map::MapSnapshot map_snapshot() const = 0;
+  /// Replaces the wall-clock stage times of the frame just processed by device-measured ones;
+  /// false (and `t` untouched) on a backend without device timers.
+  virtual bool device_stage_times(FrameTimings& t) {
+    (void)t;
+    return false;
+  }
+};
+
+/// The frame map's parameters: the submap's spacing (the scan is downsampled to it) with the
+/// frame map's lower cap, no refresh, no removal.
+VoxelMapConfig frame_map_config(const Config& config);
+
+/// The backend for config.device (auto resolved by resolve_device; `message` explains a
+/// fallback to the CPU). Throws when cuda is asked for and cannot be had.
+std::unique_ptr<ScanBackend> make_scan_backend(const Config& config, std::string* message = nullptr);
+
+}  // namespace farlio::pipeline

@@ -1,0 +1,62 @@
+// The runtime choice of the backend: device names, auto's fallback to the CPU with a message,
+// and a clear error when cuda is asked for and cannot be had.
+#include <gtest/gtest.h>
+
+#include "farlio/core/config_fields.hpp"
+#include "farlio/core/device.hpp"
+#include "farlio/pipeline/scan_pipeline.hpp"
+
+using namespace farlio;
+
+TEST(Device, NamesRoundTripAndBadNamesAreErrors) {
+  for (const Device d : {Device::Cpu, Device::Cuda, Device::Auto}) EXPECT_EQ(parse_device(device_name(d)), d);
+  try {
+    parse_device("gpu", "--device");
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("--device"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("'gpu'"), std::string::npos) << e.what();
+  }
+  Config c;
+  set_config_field(c, "device", "cpu");
+  EXPECT_EQ(c.device, Device::Cpu);
+  EXPECT_EQ(get_config_field(c, "device"), "cpu");
+  EXPECT_THROW(set_config_field(c, "device", "tpu"), std::invalid_argument);
+}
+
+TEST(Device, CpuIsAlwaysCpu) {
+  std::string message;
+  EXPECT_EQ(resolve_device(Device::Cpu, &message), Device::Cpu);
+  EXPECT_TRUE(message.empty());
+  Config c;
+  c.device = Device::Cpu;
+  const pipeline::ScanPipeline p(c);
+  EXPECT_EQ(p.backend().device(), Device::Cpu);
+  EXPECT_TRUE(p.device_message().empty());
+}
+
+TEST(Device, AutoFallsBackToTheCpuWithAMessageWithoutAGpu) {
+  if (cuda_device_count() > 0) GTEST_SKIP() << "a CUDA device is present: auto picks it";
+  std::string message;
+  EXPECT_EQ(resolve_device(Device::Auto, &message), Device::Cpu);
+  EXPECT_NE(message.find("running on the CPU"), std::string::npos) << message;
+  EXPECT_EQ(message.find('\n'), std::string::npos) << "one line";
+  Config c;  // device auto is the default
+  const pipeline::ScanPipeline p(c);
+  EXPECT_EQ(p.backend().device(), Device::Cpu);
+  EXPECT_EQ(p.device_message(), message);
+}
+
+TEST(Device, CudaWithoutAGpuIsAClearError) {
+  if (cuda_device_count() > 0) GTEST_SKIP() << "a CUDA device is present";
+  Config c;
+  c.device = Device::Cuda;
+  try {
+    const pipeline::ScanPipeline p(c);
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("device cuda was requested"), std::string::npos) << what;
+    EXPECT_NE(what.find(cuda_compiled() ? "no CUDA device" : "no CUDA backend"), std::string::npos) << what;
+  }
+}

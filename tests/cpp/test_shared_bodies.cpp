@@ -1,0 +1,87 @@
+// The kernel bodies shared by the CPU executor and CUDA (map/voxel_update.hpp,
+// registration/factor_sums.hpp, pipeline/range_crop.hpp), run here through the CPU executor
+// and directly on small inputs with known answers.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "farlio/exec/cpu_executor.hpp"
+#include "farlio/map/voxel_map.hpp"
+#include "farlio/map/voxel_update.hpp"
+#include "farlio/pipeline/range_crop.hpp"
+#include "farlio/registration/factor_sums.hpp"
+#include "farlio/registration/gicp.hpp"
+#include "scene_fixture.hpp"
+
+using namespace farlio;
+
+TEST(SharedBodies, PointKeyDropsNonFiniteAndOutOfRangePoints) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_EQ(map::point_key({nan, 0, 0}, 1.0f), map::kEmptyKey);
+  EXPECT_EQ(map::point_key({1e12f, 0, 0}, 1.0f), map::kEmptyKey);
+  EXPECT_EQ(map::point_key({1.5f, -0.5f, 2.0f}, 1.0f), map::pack_key(map::VoxelCoord(1, -1, 2)));
+}
+
+TEST(SharedBodies, RangeCropKeepsTheClosedInterval) {
+  PreprocessConfig c;
+  c.min_range_m = 1.0;
+  c.max_range_m = 10.0;
+  const auto crop = pipeline::RangeCrop::from(c);
+  EXPECT_TRUE(crop.keeps({1.0f, 0, 0}));
+  EXPECT_TRUE(crop.keeps({0, 10.0f, 0}));
+  EXPECT_FALSE(crop.keeps({0.5f, 0, 0}));
+  EXPECT_FALSE(crop.keeps({0, 0, 10.5f}));
+  EXPECT_FALSE(crop.keeps({std::numeric_limits<float>::infinity(), 0, 0}));
+}
+
+TEST(SharedBodies, VoxelGroupInsertionKeepsOrderCapAndSpacing) {
+  // one voxel of a 4 m map, spacing 1 m, at most 3 points
+  std::vector<std::uint64_t> slot_keys(16, map::kEmptyKey), voxel_keys(1, map::kEmptyKey);
+  std::vector<std::int32_t> slot_voxels(16, -1), counts(1, 0);
+  constexpr int kMax = 3;
+  std::vector<Eigen::Vector4f> points(kMax, Eigen::Vector4f::Zero());
+  std::vector<map::Cov3> covs(kMax);
+  map::MapView m{slot_keys.data(), slot_voxels.data(), 16, voxel_keys.data(), counts.data(), points.data(),
+                 covs.data(),      kMax,               4.0f, 0.25f};
+  const std::vector<Eigen::Vector3f> cand = {{0.5f, 0.5f, 0.5f}, {0.9f, 0.5f, 0.5f}, {2.0f, 0.5f, 0.5f},
+                                             {3.5f, 0.5f, 0.5f}, {0.5f, 3.5f, 0.5f}};
+  const map::InsertParams ip{Eigen::Vector3f::Zero(), map::PointLimit::constant(kMax), 1.0f};
+  std::int32_t first_new = -1;
+  const auto s = map::insert_voxel_group(m, 0, [&](std::int64_t c) { return cand[static_cast<std::size_t>(c)]; }, 0,
+                                         static_cast<std::int64_t>(cand.size()), ip, &first_new);
+  EXPECT_EQ(first_new, 0);
+  EXPECT_EQ(s.inserted, 3);
+  EXPECT_EQ(s.spacing, 1);  // (0.9, 0.5, 0.5) is 0.4 m from the first
+  EXPECT_EQ(s.full, 1);     // the last comes after the cap
+  ASSERT_EQ(counts[0], 3);
+  EXPECT_EQ(points[0].head<3>(), cand[0]);
+  EXPECT_EQ(points[1].head<3>(), cand[2]);
+  EXPECT_EQ(points[2].head<3>(), cand[3]);
+}
+
+TEST(SharedBodies, FactorSumsReduceToTheSameSystemAsPerPointSums) {
+  exec::CpuExecutor ex(2);
+  map::VoxelMap target(VoxelMapConfig{}, ex);
+  const auto pts = test::sample_scene(20000, 7);
+  target.insert(pts, Eigen::Vector3f::Zero(), map::PointLimit::constant(40));
+  registration::SourceCloud src;
+  for (std::size_t i = 0; i < pts.size(); i += 10) {
+    src.points.emplace_back(pts[i].x() + 0.05f, pts[i].y(), pts[i].z(), 0.0f);
+    src.covs.emplace_back();
+  }
+  const auto th = registration::Thresholds::from_sigma(1.0);
+  const SE3 T;
+  const auto sys = registration::build_linear_system(src, target.view(), T, th, RegistrationConfig{}, ex);
+  // serial sum of the same per-point bodies
+  const auto fp = registration::factor_params(T, th, RegistrationConfig{});
+  auto serial = registration::FactorSums::zero();
+  for (std::size_t i = 0; i < src.size(); ++i) serial += registration::factor_sums(target.view(), src.points[i], src.covs[i], fp);
+  const auto ref = registration::to_linear_system(serial);
+  EXPECT_EQ(sys.inliers, ref.inliers);
+  EXPECT_GT(sys.inliers, 0);
+  EXPECT_LT((sys.H - ref.H).norm(), 1e-9 * ref.H.norm());
+  EXPECT_LT((sys.b - ref.b).norm(), 1e-9 * (ref.b.norm() + 1.0));
+  EXPECT_NEAR(sys.error, ref.error, 1e-9 * (ref.error + 1.0));
+}

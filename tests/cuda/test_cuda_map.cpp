@@ -1,0 +1,117 @@
+// The device voxel map against the host VoxelMap on the same points: the same voxels, the same
+// points in the same pool slots, covariances equal to float rounding (and their line/surface
+// shape but for rare flips at the threshold), the same k-NN results.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "cuda_test_support.hpp"
+#include "farlio/exec/cpu_executor.hpp"
+#include "farlio/map/neighbor_search.hpp"
+#include "farlio/map/voxel_map.hpp"
+#include "scene_fixture.hpp"
+
+using namespace farlio;
+
+namespace {
+
+constexpr std::size_t kScenePoints = 120000;
+constexpr std::size_t kVoxelCapacity = 1 << 16;
+// Covariances: Eigen may vectorise the host's Frobenius norm (another summation order).
+constexpr float kCovRelTol = 1e-4f;
+// Line/surface classification (closed-form eigenvalues: acosf, cosf of libdevice vs glibc) may
+// flip for a covariance right at map.line_eigenvalue_ratio.
+constexpr double kMaxShapeFlipFraction = 1e-3;
+
+std::vector<Eigen::Vector3f> shifted(std::vector<Eigen::Vector3f> pts, const Eigen::Vector3f& d) {
+  for (auto& p : pts) p += d;
+  return pts;
+}
+
+void expect_same_maps(const map::MapSnapshot& cpu, const map::MapSnapshot& gpu) {
+  ASSERT_EQ(cpu.voxel_keys, gpu.voxel_keys);
+  ASSERT_EQ(cpu.voxel_counts, gpu.voxel_counts);
+  const auto n = static_cast<std::size_t>(cpu.max_points_per_voxel);
+  std::size_t compared = 0, flips = 0;
+  for (std::size_t v = 0; v < cpu.voxel_keys.size(); ++v) {
+    for (std::size_t j = 0; j < static_cast<std::size_t>(cpu.voxel_counts[v]); ++j, ++compared) {
+      const std::size_t i = v * n + j;
+      ASSERT_EQ(cpu.points[i].head<3>(), gpu.points[i].head<3>()) << "voxel " << v << " point " << j;
+      ASSERT_EQ(map::has_covariance(cpu.points[i]), map::has_covariance(gpu.points[i])) << "voxel " << v << " point " << j;
+      flips += map::is_line_like(cpu.points[i]) != map::is_line_like(gpu.points[i]) ? 1 : 0;
+      if (!map::has_covariance(cpu.points[i])) continue;
+      const Eigen::Matrix3f a = cpu.covs[i].matrix(), b = gpu.covs[i].matrix();
+      ASSERT_LE((a - b).norm(), kCovRelTol * a.norm()) << "voxel " << v << " point " << j;
+    }
+  }
+  EXPECT_GT(compared, 1000u);
+  EXPECT_LE(static_cast<double>(flips), kMaxShapeFlipFraction * static_cast<double>(compared));
+}
+
+}  // namespace
+
+TEST(CudaMap, InsertionRemovalAndCovariancesEqualTheCpu) {
+  FARLIO_REQUIRE_GPU();
+  VoxelMapConfig cfg;
+  cfg.voxel_size_m = 2.0;
+  cfg.removal_radius_m = 30.0;
+  exec::CpuExecutor ex(2);
+  map::VoxelMap cpu(cfg, ex);
+  test::DeviceMapRig gpu(cfg, kVoxelCapacity);
+  const map::PointLimit asmd{30, 10.0f, 0.5f, 10};
+  const auto a = test::sample_scene(kScenePoints, 11, 0.02f);
+  const auto b = shifted(test::sample_scene(kScenePoints, 12, 0.02f), {20.0f, 3.0f, 0.0f});
+  const auto sa = cpu.insert(a, Eigen::Vector3f::Zero(), asmd);
+  const auto ga = gpu.insert(a, Eigen::Vector3f::Zero(), asmd);
+  EXPECT_EQ(sa.inserted, ga.inserted);
+  EXPECT_EQ(sa.rejected_spacing, ga.rejected_spacing);
+  EXPECT_EQ(sa.rejected_full, ga.rejected_full);
+  EXPECT_EQ(sa.new_voxels, ga.new_voxels);
+  EXPECT_EQ(sa.covariances_computed, ga.covariances_computed);
+  // removal frees voxels, the next insertion reuses them in the same order
+  const Eigen::Vector3f far_origin(40.0f, 0.0f, 0.0f);
+  EXPECT_EQ(cpu.remove_far(far_origin), gpu.map.remove_far(far_origin));
+  EXPECT_EQ(cpu.insert(b, far_origin, asmd).inserted, gpu.insert(b, far_origin, asmd).inserted);
+  EXPECT_EQ(cpu.num_voxels(), gpu.map.num_voxels());
+  EXPECT_EQ(cpu.num_points(), gpu.map.num_points());
+  EXPECT_DOUBLE_EQ(cpu.mean_points_per_voxel(far_origin, 20.0), gpu.map.mean_points_per_voxel(far_origin, 20.0));
+  expect_same_maps(cpu.snapshot(), gpu.map.snapshot());
+}
+
+TEST(CudaMap, KnnEqualsTheCpu) {
+  FARLIO_REQUIRE_GPU();
+  const VoxelMapConfig cfg;
+  exec::CpuExecutor ex(2);
+  map::VoxelMap cpu(cfg, ex);
+  test::DeviceMapRig gpu(cfg, kVoxelCapacity);
+  const auto pts = test::sample_scene(kScenePoints, 21, 0.02f);
+  cpu.insert(pts, Eigen::Vector3f::Zero(), map::PointLimit::constant(40));
+  gpu.insert(pts, Eigen::Vector3f::Zero(), map::PointLimit::constant(40));
+  const auto queries = test::sample_scene(5000, 22, 0.3f);
+  constexpr int kK = 10;
+  constexpr float kMaxD2 = 4.0f;
+  const cuda::KnnResults r = gpu.map.knn(queries, kK, kMaxD2);
+  const map::MapView v = cpu.view();
+  for (std::size_t q = 0; q < queries.size(); ++q) {
+    std::int64_t idx[kK];
+    float d2[kK];
+    const int found = map::knn_search(v, queries[q], kK, kMaxD2, idx, d2);
+    ASSERT_EQ(found, r.found[q]) << "query " << q;
+    for (int j = 0; j < found; ++j) {
+      EXPECT_EQ(idx[j], r.indices[q * kK + static_cast<std::size_t>(j)]) << "query " << q << " rank " << j;
+      EXPECT_EQ(d2[j], r.distances2[q * kK + static_cast<std::size_t>(j)]) << "query " << q << " rank " << j;
+    }
+  }
+}
+
+TEST(CudaMap, AFullMapIsACapacityErrorNamingTheParameter) {
+  FARLIO_REQUIRE_GPU();
+  constexpr std::size_t kTinyCapacity = 8;
+  test::DeviceMapRig gpu(VoxelMapConfig{}, kTinyCapacity);
+  try {
+    gpu.insert(test::sample_scene(10000, 3), Eigen::Vector3f::Zero(), map::PointLimit::constant(40));
+    FAIL() << "expected CapacityError";
+  } catch (const CapacityError& e) {
+    EXPECT_NE(std::string(e.what()).find("test voxel capacity"), std::string::npos) << e.what();
+  }
+}
