@@ -10,7 +10,7 @@ Outputs in the output folder (every trajectory file names its frame):
   summary.json           frames, median/p99 latency, converged fraction, accuracy with ground truth
   config.yaml            the full effective parameter set
   eval_scans/, eval_odometry/   eval.json + eval.png against the ground truth, when there is one
-  map.ply                the final submap (with --save-map)
+  map.ply, map.pcd       the final submap, world frame (with --save-map)
   trajectory.png, latency.png   the estimated path (with ground truth) and the latency histogram (with plot)
 """
 from __future__ import annotations
@@ -162,7 +162,9 @@ def run_dataset(dataset: Dataset, out_dir: Path, config: Any = None, *, max_fram
             rel.push_back(stamp, first_inv * pose)
         _core.io.write_kitti(out_dir / "scans_lidar_kitti.txt", rel)
     if save_map:
-        _core.io.write_ply(out_dir / "map.ply", farlio.Scan(odo.map_points()))
+        submap = farlio.Scan(odo.map_points())
+        _core.io.write_ply(out_dir / "map.ply", submap)
+        _core.io.write_pcd(out_dir / "map.pcd", submap)
 
     summary: dict[str, Any] = {
         "dataset": str(dataset.path),

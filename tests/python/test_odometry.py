@@ -118,7 +118,9 @@ def test_run_cli_on_kitti_layout_and_bad_scan(tmp_path, capsys):
     assert bad.name in err and "skipping" in err
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert summary["skipped"] == 1 and summary["processed"] == summary["frames"] - 1
-    assert len(_core.io.read_point_cloud(tmp_path / "out" / "map.ply")) > 1000
+    ply = np.asarray(_core.io.read_point_cloud(tmp_path / "out" / "map.ply").points)
+    pcd = np.asarray(_core.io.read_point_cloud(tmp_path / "out" / "map.pcd").points)
+    assert len(ply) > 1000 and np.array_equal(ply, pcd)
 
 
 def test_run_cli_names_missing_input(tmp_path, capsys):

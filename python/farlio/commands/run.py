@@ -51,7 +51,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--fixed-latency", type=float, default=0.0, metavar="S", help="latency with --latency fixed")
     parser.add_argument("--added-delay", type=float, default=0.0, metavar="S",
                         help="extra delay added to every result (latency sweeps)")
-    parser.add_argument("--save-map", action="store_true", help="write the final submap as map.ply")
+    parser.add_argument("--save-map", action="store_true", help="write the final submap (world frame) as map.ply and map.pcd")
     parser.add_argument("--no-plot", action="store_true",
                         help="do not write trajectory.png, latency.png and eval.png")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
