@@ -2,16 +2,14 @@
 
 #include <cmath>
 
+#include "farlio/core/time.hpp"
 #include "farlio/deskew/motion_fit.hpp"
 
 namespace farlio::pipeline {
 namespace {
 
-constexpr double kNsPerS = 1e9;
 // Poses sampled over a scan for the motion regression.
 constexpr int kMotionSamples = 11;
-
-std::int64_t to_ns(double s) { return static_cast<std::int64_t>(std::llround(s * kNsPerS)); }
 
 std::optional<deskew::ScanMotion> motion_from_fusion(const fusion::SensorFusion& fusion, const Scan& scan,
                                                      const SE3& end_pose, const SE3& T_imu_lidar) {
@@ -19,7 +17,7 @@ std::optional<deskew::ScanMotion> motion_from_fusion(const fusion::SensorFusion&
   std::vector<std::pair<double, SE3>> samples;
   for (int i = 0; i < kMotionSamples; ++i) {
     const double tau = scan.duration_s() * i / (kMotionSamples - 1);
-    const auto body = fusion.pose_at(scan.start_stamp_ns + to_ns(tau));
+    const auto body = fusion.pose_at(scan.start_stamp_ns + seconds_to_ns(tau));
     if (body) samples.emplace_back(tau, *body * T_imu_lidar);
   }
   if (samples.size() < 2) return std::nullopt;
@@ -33,7 +31,7 @@ SE3 gravity_aligned_start(const std::vector<ImuSample>& imu, std::int64_t until_
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   int n = 0;
   for (const auto& s : imu) {
-    if (s.stamp_ns > until_ns || s.stamp_ns - imu.front().stamp_ns > to_ns(kGravityAlignmentWindow_s)) break;
+    if (s.stamp_ns > until_ns || s.stamp_ns - imu.front().stamp_ns > seconds_to_ns(kGravityAlignmentWindow_s)) break;
     mean += s.accel_m_s2;
     ++n;
   }

@@ -1,18 +1,11 @@
 #include "farlio/pipeline/odometry.hpp"
 
 #include <algorithm>
-#include <cmath>
 
+#include "farlio/core/time.hpp"
 #include "farlio/pipeline/fusion_link.hpp"
 
 namespace farlio::pipeline {
-namespace {
-
-constexpr double kNsPerS = 1e9;
-
-std::int64_t to_ns(double s) { return static_cast<std::int64_t>(std::llround(s * kNsPerS)); }
-
-}  // namespace
 
 Odometry::Odometry(const Config& config, const SE3& T_imu_lidar, double gravity_m_s2, std::vector<ImuSample> imu,
                    const ReplayOptions& options)
@@ -46,7 +39,7 @@ void Odometry::advance_clock(std::int64_t stamp_ns) {
     clock_ns_ = stamp_ns;
     return;
   }
-  const std::int64_t step_ns = to_ns(config_.fusion.step_s);
+  const std::int64_t step_ns = seconds_to_ns(config_.fusion.step_s);
   if (next_output_ns_ == 0) next_output_ns_ = (clock_ns_ / step_ns + 1) * step_ns;
   // Feed the IMU and step the filter up to each output instant, then emit the estimate.
   auto feed_to = [&](std::int64_t t) {
@@ -95,7 +88,7 @@ OdometryFrame Odometry::process(const Scan& scan) {
   out.scan = pipeline_.process(scan, prior.guess, prior.motion);
   out.processed = true;
   out.body_pose = out.scan.pose * T_lidar_imu_;
-  out.available_ns = out.started_ns + to_ns(latency_s(out.scan));
+  out.available_ns = out.started_ns + seconds_to_ns(latency_s(out.scan));
   busy_until_ns_ = out.available_ns;
 
   out.drop_reason = drop_reason(out.scan, last_body_.has_value());

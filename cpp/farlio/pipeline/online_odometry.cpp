@@ -1,14 +1,9 @@
 #include "farlio/pipeline/online_odometry.hpp"
 
-#include <cmath>
-
+#include "farlio/core/time.hpp"
 #include "farlio/pipeline/fusion_link.hpp"
 
 namespace farlio::pipeline {
-namespace {
-constexpr double kNsPerS = 1e9;
-std::int64_t to_ns(double s) { return static_cast<std::int64_t>(std::llround(s * kNsPerS)); }
-}  // namespace
 
 OnlineOdometry::OnlineOdometry(const Config& config, const SE3& T_imu_lidar, double gravity_m_s2,
                                OdometryCallback on_odometry, FrameCallback on_frame)
@@ -39,11 +34,11 @@ void OnlineOdometry::add_imu(const ImuSample& sample) {
     std::lock_guard lock(state_mutex_);
     if (!fusion_) return;
     if (!inertial_decided_ && (startup_imu_.empty() || sample.stamp_ns - startup_imu_.front().stamp_ns <=
-                                                           to_ns(kGravityAlignmentWindow_s))) {
+                                                           seconds_to_ns(kGravityAlignmentWindow_s))) {
       startup_imu_.push_back(sample);
     }
     // As the replay does: every step sees exactly the samples stamped up to its instant.
-    const std::int64_t step_ns = to_ns(config_.fusion.step_s);
+    const std::int64_t step_ns = seconds_to_ns(config_.fusion.step_s);
     if (next_output_ns_ == 0) next_output_ns_ = (sample.stamp_ns / step_ns + 1) * step_ns;
     auto emit_step = [&] {
       fusion_->advance_to(next_output_ns_);
