@@ -96,13 +96,13 @@ inline SimResult simulate(const TestTrajectory& traj, const FusionConfig& config
       if (o.accel_in_g) m.accel_m_s2 /= kGravity_m_s2;
       f.add_imu(m);
     }
-    f.advance_to(to_ns(now));
+    f.advance_to(seconds_to_ns(now));
     while (true) {
       const double stamp = o.lidar_hz > 0.0 ? lidar_k / o.lidar_hz : 0.0;
       const double delivered = stamp + (lidar_k == 0 ? 0.0 : o.lidar_delay_s);
       if ((lidar_k > 0 && o.lidar_hz <= 0.0) || delivered > now + 1e-12) break;
       if (lidar_k == 0) {
-        f.add_lidar(to_ns(0.0), traj.pose(0.0), traj.velocity_body(0.0), true);
+        f.add_lidar(seconds_to_ns(0.0), traj.pose(0.0), traj.velocity_body(0.0), true);
       } else {
         const SE3 truth = traj.pose(stamp);
         Eigen::Vector3d p = truth.translation() + noise3(o.lidar_position_noise_m);
@@ -111,7 +111,7 @@ inline SimResult simulate(const TestTrajectory& traj, const FusionConfig& config
         if (lidar_k == o.outlier_index) R = so3_exp(Eigen::Vector3d(0.0, 0.0, o.outlier_yaw_offset_rad)) * R;
         // A skipped result still draws its noise, so that the other results stay identical.
         if (lidar_k != o.skip_index) {
-          r.lidar_results.push_back(f.add_lidar(to_ns(stamp), SE3(R, p), Eigen::Vector3d::Zero(), false));
+          r.lidar_results.push_back(f.add_lidar(seconds_to_ns(stamp), SE3(R, p), Eigen::Vector3d::Zero(), false));
         } else {
           r.lidar_results.emplace_back();
         }
@@ -120,7 +120,7 @@ inline SimResult simulate(const TestTrajectory& traj, const FusionConfig& config
     }
     const fusion::BodyEstimate e = f.estimate();
     if (!e.valid) continue;
-    const double t_est = static_cast<double>(e.stamp_ns) / kNsPerS;
+    const double t_est = ns_to_seconds(e.stamp_ns);
     const SE3 truth = traj.pose(t_est);
     if (!e.pose.translation().allFinite()) r.finite = false;
     r.steps.push_back({t_est, e.pose.translation() - truth.translation(), rotation_error_deg(e.pose, truth)});

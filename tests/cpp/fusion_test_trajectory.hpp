@@ -9,15 +9,13 @@
 #include <numbers>
 
 #include "farlio/core/se3.hpp"
+#include "farlio/core/time.hpp"
 #include "farlio/core/types.hpp"
 
 namespace farlio::test {
 
 inline constexpr double kGravity_m_s2 = 9.81;
 inline constexpr double kDegPerRad = 180.0 / std::numbers::pi;
-inline constexpr double kNsPerS = 1e9;
-
-inline std::int64_t to_ns(double t_s) { return std::llround(t_s * kNsPerS); }
 
 /// A circle of speed speed_m_s and yaw rate yaw_rate_rad_s (heading along the path), with roll,
 /// pitch and height oscillating at wobble_hz.
@@ -74,7 +72,7 @@ struct TestTrajectory {
   [[nodiscard]] ImuSample imu(double t) const {
     const Sample s = at(t);
     ImuSample m;
-    m.stamp_ns = to_ns(t);
+    m.stamp_ns = seconds_to_ns(t);
     m.gyro_rad_s = angular_velocity_body(t);
     m.accel_m_s2 = rotation(s.rpy).transpose() * (s.a_world - Eigen::Vector3d(0.0, 0.0, -kGravity_m_s2));
     return m;

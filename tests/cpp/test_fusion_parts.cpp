@@ -23,10 +23,10 @@ TEST(FusionParts, ReferenceAnglesRecoverTrueRollAndPitchOnAFastCurve) {
   for (int k = 0; k < 300; ++k) {
     const double t = k * kDt;
     const ImuSample m = traj.imu(t);
-    const auto a = est.push(to_ns(t), traj.velocity_body(t), m.accel_m_s2, m.gyro_rad_s);
+    const auto a = est.push(seconds_to_ns(t), traj.velocity_body(t), m.accel_m_s2, m.gyro_rad_s);
     if (!a) continue;
     ++produced;
-    const Eigen::Vector3d truth = traj.rpy(static_cast<double>(a->stamp_ns) / kNsPerS);
+    const Eigen::Vector3d truth = traj.rpy(ns_to_seconds(a->stamp_ns));
     EXPECT_FALSE(a->saturated);
     max_err_deg = std::max({max_err_deg, std::abs(a->roll_rad - truth.x()) * kDegPerRad,
                             std::abs(a->pitch_rad - truth.y()) * kDegPerRad});
@@ -120,12 +120,12 @@ TEST(FusionParts, HistoryInterpolatesAndForgets) {
     StateVector x = StateVector::Zero();
     x(0) = k;
     x(kAttitudeIndex + 2) = 0.1 * k;
-    h.push(to_ns(0.01 * k), x);
+    h.push(seconds_to_ns(0.01 * k), x);
   }
   EXPECT_EQ(h.size(), 5u);
-  EXPECT_EQ(h.oldest().stamp_ns, to_ns(0.03));
-  EXPECT_FALSE(h.state_at(to_ns(0.02)).has_value());
-  const auto mid = h.state_at(to_ns(0.055));
+  EXPECT_EQ(h.oldest().stamp_ns, seconds_to_ns(0.03));
+  EXPECT_FALSE(h.state_at(seconds_to_ns(0.02)).has_value());
+  const auto mid = h.state_at(seconds_to_ns(0.055));
   ASSERT_TRUE(mid.has_value());
   EXPECT_NEAR((*mid)(0), 5.5, 1e-9);
   EXPECT_NEAR((*mid)(kAttitudeIndex + 2), 0.55, 1e-9);

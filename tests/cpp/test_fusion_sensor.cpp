@@ -44,10 +44,10 @@ FusionConfig matched_config() {
 TEST(FusionSensor, NoEstimateBeforeTheFirstLidarResult) {
   fusion::SensorFusion f(FusionConfig{}, kGravity_m_s2);
   f.add_imu(fast_curve().imu(0.0));
-  f.advance_to(to_ns(0.5));
+  f.advance_to(seconds_to_ns(0.5));
   EXPECT_FALSE(f.initialized());
   EXPECT_FALSE(f.estimate().valid);
-  EXPECT_FALSE(f.pose_at(to_ns(0.1)).has_value());
+  EXPECT_FALSE(f.pose_at(seconds_to_ns(0.1)).has_value());
 }
 
 TEST(FusionSensor, NoiseFreePredictionFollowsTheTruthForOneSecond) {
@@ -181,7 +181,7 @@ TEST(FusionSensor, TooOldLidarAndOutOfOrderImuAreRejected) {
   fusion::SensorFusion f(matched_config(), kGravity_m_s2);
   SimOptions o = noisy_options(3.0);
   simulate(slow_curve(), matched_config(), o, &f);
-  const auto old = f.add_lidar(to_ns(1.5), slow_curve().pose(1.5), Eigen::Vector3d::Zero(), false);
+  const auto old = f.add_lidar(seconds_to_ns(1.5), slow_curve().pose(1.5), Eigen::Vector3d::Zero(), false);
   EXPECT_FALSE(old.position_accepted);
   EXPECT_FALSE(old.rejection_reason.empty());
   EXPECT_EQ(f.stats().lidar_too_old, 1);
@@ -196,15 +196,15 @@ TEST(FusionSensor, PoseAtInterpolatesTheHistory) {
   o.lidar_hz = 0.0;
   simulate(fast_curve(), plain_config(), o, &f);
   for (double t : {0.2, 0.355, 0.999, 1.0}) {
-    const auto pose = f.pose_at(to_ns(t));
+    const auto pose = f.pose_at(seconds_to_ns(t));
     ASSERT_TRUE(pose.has_value()) << t;
     EXPECT_LT(position_error_m(*pose, fast_curve().pose(t)), 0.02) << t;
     EXPECT_LT(rotation_error_deg(*pose, fast_curve().pose(t)), 0.1) << t;
   }
-  const auto ahead = f.pose_at(to_ns(1.05));  // extrapolated with the last input
+  const auto ahead = f.pose_at(seconds_to_ns(1.05));  // extrapolated with the last input
   ASSERT_TRUE(ahead.has_value());
   EXPECT_LT(position_error_m(*ahead, fast_curve().pose(1.05)), 0.05);
-  EXPECT_FALSE(f.pose_at(to_ns(1.5)).has_value());
-  EXPECT_FALSE(f.pose_at(to_ns(-0.5)).has_value());
+  EXPECT_FALSE(f.pose_at(seconds_to_ns(1.5)).has_value());
+  EXPECT_FALSE(f.pose_at(seconds_to_ns(-0.5)).has_value());
   EXPECT_NEAR(f.angular_velocity_body().z(), fast_curve().angular_velocity_body(1.0).z(), 1e-6);
 }

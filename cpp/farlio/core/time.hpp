@@ -1,13 +1,18 @@
 #pragma once
-// Stamps are integer nanoseconds; durations in the parameter set are seconds.
+// Stamps are integer nanoseconds; durations in the parameter set are seconds. The one place that
+// converts between them.
 #include <cmath>
 #include <cstdint>
 
 namespace farlio {
 
-inline constexpr double kNsPerS = 1e9;
+inline constexpr std::int64_t kNsPerSecond = 1'000'000'000;
+inline constexpr double kNsPerS = static_cast<double>(kNsPerSecond);
 
 /// Seconds to nanoseconds, rounded to the nearest.
 inline std::int64_t seconds_to_ns(double seconds) { return static_cast<std::int64_t>(std::llround(seconds * kNsPerS)); }
+
+/// Nanoseconds (a stamp difference) to seconds.
+inline double ns_to_seconds(std::int64_t ns) { return static_cast<double>(ns) / kNsPerS; }
 
 }  // namespace farlio

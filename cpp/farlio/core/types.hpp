@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "farlio/core/time.hpp"
+
 namespace farlio {
 
 using Vec3f = Eigen::Vector3f;
@@ -13,7 +15,7 @@ using Vec3d = Eigen::Vector3d;
 
 /// One LiDAR scan (several LiDARs merged into one frame are still one scan).
 struct Scan {
-  /// Scan start and end in ns. A point's absolute time is start_stamp_ns + time_s[i] * 1e9.
+  /// Scan start and end in ns. A point's absolute time is start_stamp_ns + seconds_to_ns(time_s[i]).
   std::int64_t start_stamp_ns = 0;
   std::int64_t end_stamp_ns = 0;
   /// Points in the LiDAR frame at the instant each was measured (raw, motion-distorted).
@@ -29,7 +31,7 @@ struct Scan {
   [[nodiscard]] bool empty() const { return points.empty(); }
   [[nodiscard]] bool has_time() const { return !time_s.empty(); }
   [[nodiscard]] double duration_s() const {
-    return static_cast<double>(end_stamp_ns - start_stamp_ns) * 1e-9;
+    return ns_to_seconds(end_stamp_ns - start_stamp_ns);
   }
   /// Throws InputError naming `what` if array sizes disagree or the stamps are inverted.
   void validate(const std::string& what) const;

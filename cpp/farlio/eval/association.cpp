@@ -6,11 +6,11 @@
 #include <string>
 
 #include "farlio/core/error.hpp"
+#include "farlio/core/time.hpp"
 
 namespace farlio::eval {
 namespace {
 
-constexpr double kNanosecondsPerSecond = 1e9;
 
 /// Index of the stamp in sorted `stamps` nearest to t (earlier one on a tie); stamps non-empty.
 std::size_t nearest_index(const std::vector<std::int64_t>& stamps, std::int64_t t) {
@@ -48,7 +48,6 @@ std::optional<SE3> interpolate_within_gap(const Trajectory& gt, const std::vecto
 
 }  // namespace
 
-std::int64_t seconds_to_ns(double seconds) { return std::llround(seconds * kNanosecondsPerSecond); }
 
 AssociatedPoses associate(const Trajectory& estimate, const Trajectory& groundtruth,
                           const AssociationOptions& options) {

@@ -51,7 +51,4 @@ AssociatedPoses associate(const Trajectory& estimate, const Trajectory& groundtr
 /// 0 for an empty stamp list.
 double coverage(const Trajectory& estimate, std::span<const std::int64_t> scan_stamps_ns, double max_time_diff_s);
 
-/// Seconds -> nanoseconds, rounded to the nearest nanosecond.
-std::int64_t seconds_to_ns(double seconds);
-
 }  // namespace farlio::eval

@@ -1,4 +1,5 @@
 #include "farlio/fusion/imu_buffer.hpp"
+#include "farlio/core/time.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,13 +7,12 @@
 
 namespace farlio::fusion {
 namespace {
-constexpr double kNsPerS = 1e9;
 
 ImuReading reading_of(const ImuSample& s, bool in_gap) { return {s.gyro_rad_s, s.accel_m_s2, in_gap}; }
 }  // namespace
 
 ImuBuffer::ImuBuffer(double gap_limit_s, double retention_s)
-    : gap_limit_ns_(std::llround(gap_limit_s * kNsPerS)), retention_ns_(std::llround(retention_s * kNsPerS)) {}
+    : gap_limit_ns_(seconds_to_ns(gap_limit_s)), retention_ns_(seconds_to_ns(retention_s)) {}
 
 bool ImuBuffer::push(const ImuSample& sample) {
   if (!samples_.empty() && sample.stamp_ns < samples_.back().stamp_ns) return false;

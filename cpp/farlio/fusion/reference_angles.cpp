@@ -1,4 +1,5 @@
 #include "farlio/fusion/reference_angles.hpp"
+#include "farlio/core/time.hpp"
 
 #include <Eigen/Geometry>
 
@@ -8,7 +9,6 @@
 
 namespace farlio::fusion {
 namespace {
-constexpr double kNsPerS = 1e9;
 constexpr int kMinTaps = 1;
 
 /// asin of the clamped argument; sets `saturated` when clamped.
@@ -55,7 +55,7 @@ std::optional<ReferenceAngles> ReferenceAngleEstimator::push(std::int64_t stamp_
     const Sample& prev = samples_[i];
     const Sample& cur = samples_[i + 1];
     const Sample& next = samples_[i + 2];
-    const double span_s = static_cast<double>(next.stamp_ns - prev.stamp_ns) / kNsPerS;
+    const double span_s = ns_to_seconds(next.stamp_ns - prev.stamp_ns);
     const Eigen::Vector3d v_dot = (next.v - prev.v) / span_s;
     g_body += weights_(static_cast<Eigen::Index>(i)) * (v_dot - cur.a + cur.w.cross(cur.v));
   }

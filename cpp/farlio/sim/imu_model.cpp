@@ -3,10 +3,10 @@
 #include <cmath>
 
 #include "farlio/sim/random.hpp"
+#include "farlio/core/time.hpp"
 
 namespace farlio::sim {
 namespace {
-constexpr double kNsPerS = 1e9;
 
 Eigen::Vector3d gaussian3(std::uint64_t seed, Stream stream, std::uint64_t index) {
   return {standard_normal(seed, stream, index, 0), standard_normal(seed, stream, index, 1),
@@ -32,7 +32,7 @@ std::vector<ImuSample> generate_imu(const MotionModel& motion, const SimConfig& 
   for (std::size_t k = 0; k < count; ++k) {
     const double t_s = static_cast<double>(k) * dt_s;
     ImuSample s = ideal_imu_reading(motion.state(t_s), config.gravity_m_s2);
-    s.stamp_ns = config.start_stamp_ns + std::llround(t_s * kNsPerS);
+    s.stamp_ns = config.start_stamp_ns + seconds_to_ns(t_s);
     if (!config.noise_free) {
       s.gyro_rad_s += gyro_bias + n.gyro_noise_std_rad_s * gaussian3(config.seed, Stream::ImuGyro, k);
       s.accel_m_s2 += accel_bias + n.accel_noise_std_m_s2 * gaussian3(config.seed, Stream::ImuAccel, k);

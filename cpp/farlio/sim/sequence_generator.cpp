@@ -11,11 +11,10 @@
 
 #include "farlio/sim/imu_model.hpp"
 #include "farlio/sim/random.hpp"
+#include "farlio/core/time.hpp"
 
 namespace farlio::sim {
 namespace {
-constexpr double kNsPerS = 1e9;
-constexpr double kSPerNs = 1e-9;
 constexpr float kIntensityScale = 100.0F;
 /// Columns per TBB task.
 constexpr std::size_t kColumnsPerTask = 16;
@@ -53,7 +52,7 @@ std::int64_t SequenceGenerator::scan_start_ns(std::size_t i) const {
 }
 
 double SequenceGenerator::seconds_since_start(std::int64_t stamp_ns) const {
-  return static_cast<double>(stamp_ns - config_.start_stamp_ns) * kSPerNs;
+  return ns_to_seconds(stamp_ns - config_.start_stamp_ns);
 }
 
 BodyState SequenceGenerator::state(std::int64_t stamp_ns) const {
@@ -79,7 +78,7 @@ Scan SequenceGenerator::scan(std::size_t i) const {
   out.start_stamp_ns = scan_start_ns(i);
   out.end_stamp_ns = out.start_stamp_ns + period_ns_;
   const double start_s = seconds_since_start(out.start_stamp_ns);
-  const double period_s = static_cast<double>(period_ns_) * kSPerNs;
+  const double period_s = ns_to_seconds(period_ns_);
   const NoiseConfig& noise = config_.noise;
 
   // One slot per ray, compacted afterwards so the order is independent of threading.
