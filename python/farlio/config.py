@@ -24,10 +24,6 @@ def _flatten(d: dict, prefix: str = "") -> dict[str, Any]:
     return out
 
 
-def _text(v: Any) -> str:
-    return ("true" if v else "false") if isinstance(v, bool) else str(v)
-
-
 def load_config(yaml_path: Path | None = None, overrides: Iterable[str] = ()) -> Config:
     """Defaults, then the YAML file, then `key=value` overrides (later wins)."""
     cfg = Config()
@@ -37,7 +33,7 @@ def load_config(yaml_path: Path | None = None, overrides: Iterable[str] = ()) ->
             raise ValueError(f"{yaml_path}: expected a mapping of config fields")
         for name, value in _flatten(data).items():
             try:
-                cfg.set(name, _text(value))
+                cfg.set(name, value)
             except ValueError as e:
                 raise ValueError(f"{yaml_path}: {e}") from None
     for item in overrides:
@@ -45,16 +41,17 @@ def load_config(yaml_path: Path | None = None, overrides: Iterable[str] = ()) ->
             raise ValueError(f"--set expects key=value, got '{item}'")
         name, value = item.split("=", 1)
         cfg.set(name.strip(), value.strip())
+    cfg.validate()  # the rules between fields (each value was checked as it was set)
     return cfg
 
 
 def config_to_yaml(cfg: Config) -> str:
     """The full effective config as nested YAML (every field, defaults included)."""
     nested: dict[str, Any] = {}
-    for name, text in cfg.to_dict().items():
+    for name, value in cfg.to_dict().items():
         node = nested
         *parents, leaf = name.split(".")
         for p in parents:
             node = node.setdefault(p, {})
-        node[leaf] = yaml.safe_load(text)
+        node[leaf] = value
     return yaml.safe_dump(nested, sort_keys=False)

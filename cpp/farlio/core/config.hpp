@@ -1,141 +1,188 @@
 #pragma once
-// The one parameter set of farlio. Every field has its unit in its name and a documented
-// default; the defaults serve every sensor and dataset (one parameter set, as in the paper).
-// YAML files and command-line overrides map onto these fields by their dotted names
-// (e.g. `map.voxel_size_m`); a run writes the full effective config next to its outputs.
+// The one parameter set of farlio. Every field has its unit in its name, a documented default and
+// a valid range; the defaults serve every sensor and dataset (one parameter set, as in the paper).
+// YAML files and command-line overrides map onto the fields by their dotted names (e.g.
+// `map.voxel_size_m`); a run writes the full effective config next to its outputs; `farlio config`
+// prints every field with its default, range and meaning.
+//
+// Each section is one list, the only place a field is written down:
+//   FIELD(type, name, default, valid range (config_range.hpp), documentation)
+// The list declares the struct's members with their defaults (below) and gives config_fields.cpp
+// the dotted names, the documentation and the validation.
 #include <cstdint>
 
+#include "farlio/core/config_range.hpp"
 #include "farlio/core/device.hpp"
 
 namespace farlio {
 
-/// Range crop and downsampling of each incoming scan.
+/// The k-NN buffers hold this many neighbours at most (map.covariance_neighbors' upper bound).
+inline constexpr int kMaxCovarianceNeighbors = 32;
+/// Voxels are indexed by int32 in the pool.
+inline constexpr double kMaxVoxelCapacity = 2147483647.0;
+
+// ---- preprocess: range crop of each incoming scan ----------------------------------------------
+#define FARLIO_PREPROCESS_FIELDS(FIELD)                                                                \
+  FIELD(double, min_range_m, 1.0, range::non_negative(),                                              \
+        "points closer than this to the sensor are dropped (the vehicle body)")                      \
+  FIELD(double, max_range_m, 200.0, range::positive_or_inf(), "points farther than this are dropped") \
+  FIELD(bool, undistort, true, range::unchecked(), "motion undistortion (MU) of points with per-point times")
+
+// ---- map: the voxel hash map (the paper's cuVoxelMap), the adaptive local submap ----------------
+#define FARLIO_MAP_FIELDS(FIELD)                                                                          \
+  FIELD(double, voxel_size_m, 4.0, range::positive(),                                                    \
+        "v: edge of a voxel cube (paper: 4 m); the upper bound when auto_voxel_size")                    \
+  FIELD(bool, auto_voxel_size, true, range::unchecked(),                                                 \
+        "scale the voxel to the scene at the first scan: v = clamp(p90 range / auto_range_ratio, "       \
+        "auto_min_voxel_size_m, voxel_size_m); vehicles outdoors keep 4 m, rooms get a finer map")       \
+  FIELD(double, auto_range_ratio, 6.0, range::positive(), "p90 range of the first scan over the voxel size (auto)") \
+  FIELD(double, auto_min_voxel_size_m, 1.0, range::positive(), "smallest voxel the auto scaling picks")  \
+  FIELD(int, max_points_per_voxel, 40, range::at_least(1), "N_max: points a voxel holds at most (paper: 40)") \
+  FIELD(double, point_spacing_m, 0.0, range::non_negative(),                                             \
+        "minimum distance between points of a voxel; 0: voxel_size_m / sqrt(N_max) (0.63 m at 4 m)")    \
+  FIELD(int, covariance_neighbors, 10, range::between(1, kMaxCovarianceNeighbors),                       \
+        "k nearest neighbours of a point covariance (paper: 10)")                                        \
+  FIELD(double, covariance_epsilon, 1e-3, range::positive(),                                             \
+        "eps of the Frobenius regularisation: C = Sigma_hat + eps I, eq. (1)")                           \
+  FIELD(double, line_eigenvalue_ratio, 10.0, range::non_negative(),                                      \
+        "a covariance is line-like (a scan line, a pole) when, regularised, its middle eigenvalue is "   \
+        "below ratio x the smallest while the largest is above it; 0: never (all surfaces)")            \
+  FIELD(double, removal_radius_m, 1000.0, range::positive_or_inf(),                                      \
+        "voxels whose centre is farther than this from the pose are removed (inf: never)")               \
+  FIELD(bool, refresh_covariances, true, range::unchecked(),                                             \
+        "recompute the covariances of existing points in voxels that receive new points "                \
+        "(the reference never refreshes them)")                                                          \
+  FIELD(std::int64_t, initial_voxel_capacity, 1 << 14, range::between(1, kMaxVoxelCapacity),             \
+        "voxels preallocated; the pool doubles as needed")                                               \
+  FIELD(std::int64_t, max_voxel_capacity, 1 << 20, range::between(1, kMaxVoxelCapacity),                 \
+        "hard limit of the submap in voxels: growth beyond it is a CapacityError")
+
+// ---- density: adaptive submap density (ASMD), the per-voxel limit follows the scan's density ---
+#define FARLIO_DENSITY_FIELDS(FIELD)                                                                    \
+  FIELD(bool, enabled, true, range::unchecked(), "adaptive submap density (ASMD)")                     \
+  FIELD(double, close_range_m, 20.0, range::positive(),                                                \
+        "the scan's density is averaged over frame-map voxels within this range")                     \
+  FIELD(double, slope_points_per_m, 0.03, range::non_negative(), "linear decay of the per-voxel limit beyond close_range_m") \
+  FIELD(int, frame_map_max_points_per_voxel, 20, range::at_least(1),                                   \
+        "cap of the per-scan frame map that gives the source covariances (reference: 20)")
+
+// ---- threshold: KISS-ICP's adaptive correspondence threshold -----------------------------------
+#define FARLIO_THRESHOLD_FIELDS(FIELD)                                                                 \
+  FIELD(double, initial_threshold_m, 1.0, range::positive(), "sigma before any model deviation is observed") \
+  FIELD(double, min_motion_m, 0.25, range::non_negative(), "model deviations below this are not sampled") \
+  FIELD(double, max_range_m, 100.0, range::positive(), "range that turns a rotation error into a displacement") \
+  FIELD(double, max_threshold_m, 10.0, range::positive(), "sigma is capped here")
+
+// ---- registration: sparsity-aware GICP, scan to submap -----------------------------------------
+#define FARLIO_REGISTRATION_FIELDS(FIELD)                                                              \
+  FIELD(bool, sparsity_aware, true, range::unchecked(), "GICP (true) or plain point-to-point ICP for every point (false)") \
+  FIELD(double, point_to_point_sigma_m, 0.0, range::non_negative(),                                   \
+        "residual std per axis of points without covariance (point-to-point factors); 0: half the map " \
+        "spacing; the paper's Omega = I is sqrt(map.covariance_epsilon) = 0.0316 (docs/odometry.md)")  \
+  FIELD(bool, skip_line_pairs, true, range::unchecked(),                                              \
+        "leave out correspondences whose two covariances are both line-like: two scan lines recorded " \
+        "from the same place fake a constraint across the line")                                       \
+  FIELD(int, max_iterations, 500, range::at_least(1), "Gauss-Newton iterations at most")              \
+  FIELD(double, convergence_norm, 5e-3, range::positive(), "stop when |dx| (6-vector, m and rad) falls below this") \
+  FIELD(double, time_budget_factor, 2.0, range::positive_or_inf(),                                    \
+        "time budget in LiDAR periods (paper: 2); a frame over it is dropped (inf: no budget)")        \
+  FIELD(double, damping, 1e-9, range::non_negative(), "lambda added to the diagonal of H")
+
+// ---- fusion: the kinematic EKF (paper eqs. 7-10) fusing IMU inputs with LiDAR poses -------------
+// Variances are given as standard deviations (unit in the name); docs/fusion.md explains each.
+#define FARLIO_FUSION_FIELDS(FIELD)                                                                       \
+  FIELD(bool, enabled, true, range::unchecked(), "fuse the IMU (LIO); false or no IMU: LiDAR-only odometry") \
+  FIELD(double, step_s, 0.01, range::between(1e-4, 1.0), "fixed EKF step and odometry output period (paper: 100 Hz)") \
+  FIELD(double, history_s, 1.0, range::positive(), "state history kept for delay compensation and pose queries") \
+  FIELD(double, max_extrapolation_s, 0.1, range::non_negative(),                                         \
+        "a pose may be predicted this far beyond the newest step")                                       \
+  FIELD(double, imu_gap_limit_s, 0.1, range::positive(),                                                 \
+        "IMU samples farther apart are a gap: the last input is held")                                   \
+  FIELD(double, gyro_input_std_rad_s, 0.02, range::positive(),                                           \
+        "std of the gyro input averaged over one step, process noise B Q B^T "                           \
+        "(reference: variances 3e-4..3e-3 rad^2/s^2 at 100 Hz)")                                         \
+  FIELD(double, accel_input_std_m_s2, 1.0, range::positive(),                                            \
+        "std of the accelerometer input averaged over one step, process noise B Q B^T "                  \
+        "(reference: variances 1..4 m^2/s^4 at 100 Hz)")                                                 \
+  FIELD(double, initial_position_std_m, 0.1, range::positive(), "position std at initialisation (the first LiDAR pose)") \
+  FIELD(double, initial_attitude_std_rad, 0.02, range::positive(), "roll/pitch/yaw std at initialisation") \
+  FIELD(double, initial_velocity_std_m_s, 20.0, range::positive(),                                       \
+        "velocity std at initialisation when the first LiDAR result carries no velocity")                \
+  FIELD(double, lidar_position_std_m, 0.05, range::positive(), "LiDAR position measurement std per axis") \
+  FIELD(double, lidar_roll_pitch_std_rad, 0.02, range::positive(), "LiDAR roll and pitch measurement std") \
+  FIELD(double, lidar_yaw_std_rad, 0.01, range::positive(), "LiDAR yaw measurement std")                 \
+  FIELD(double, lidar_velocity_std_m_s, 0.8, range::positive(),                                          \
+        "LiDAR body velocity (eq. 6) measurement std per axis")                                          \
+  FIELD(bool, outlier_rejection, true, range::unchecked(), "Mahalanobis outlier rejection per measurement group") \
+  FIELD(double, outlier_chi2_3dof, 16.27, range::positive(), "chi-square gate of 3-dof groups (99.9 % quantile)") \
+  FIELD(double, outlier_chi2_2dof, 13.82, range::positive(), "chi-square gate of 2-dof groups (99.9 % quantile)") \
+  FIELD(int, max_consecutive_rejections, 10, range::at_least(1),                                         \
+        "LiDAR positions rejected in a row before the filter re-initialises from the LiDAR pose")        \
+  FIELD(bool, reference_angles, true, range::unchecked(),                                                \
+        "fuse roll/pitch reference angles, a pseudo-measurement from gravity in the body frame")         \
+  FIELD(double, reference_roll_std_rad, 0.22, range::positive(), "reference roll std (reference: variance 0.05 rad^2)") \
+  FIELD(double, reference_pitch_std_rad, 0.32, range::positive(), "reference pitch std (reference: variance 0.1 rad^2)") \
+  FIELD(int, reference_filter_taps, 11, range::at_least(1), "taps of the Hann low-pass of the reference angle terms (odd)") \
+  FIELD(double, reference_max_sin, 0.5, range::fraction(),                                               \
+        "clamp of the asin argument (30 deg); clamped reference angles are not fused")                   \
+  FIELD(bool, delay_compensation, true, range::unchecked(), "shift delayed measurements by eq. (10)")     \
+  FIELD(int, update_spread_steps, 0, range::non_negative(),                                              \
+        "N: a LiDAR result is injected over N steps with N R each; 0: the LiDAR period / step_s")        \
+  FIELD(int, max_update_spread_steps, 20, range::at_least(1), "cap of the automatic N")                  \
+  FIELD(bool, standstill_bias, true, range::unchecked(),                                                 \
+        "learn the gyro bias at standstill (the accelerometer bias stays at its initial value, as in the paper)") \
+  FIELD(double, standstill_max_speed_m_s, 0.4, range::non_negative(), "standstill: estimated speed below this") \
+  FIELD(double, standstill_max_gyro_rad_s, 0.05, range::non_negative(), "standstill: |gyro| below this") \
+  FIELD(double, standstill_max_accel_deviation_m_s2, 1.0, range::non_negative(), "standstill: | |accel| - g | below this") \
+  FIELD(int, bias_window_samples, 10000, range::at_least(1), "gyro bias running mean over at most this many samples") \
+  FIELD(int, bias_prior_samples, 100, range::non_negative(), "weight of the initial gyro bias in the mean, in samples") \
+  FIELD(double, gyro_bias_init_x_rad_s, 0.0, range::finite(), "initial gyro bias x")                     \
+  FIELD(double, gyro_bias_init_y_rad_s, 0.0, range::finite(), "initial gyro bias y")                     \
+  FIELD(double, gyro_bias_init_z_rad_s, 0.0, range::finite(), "initial gyro bias z")                     \
+  FIELD(double, accel_bias_x_m_s2, 0.0, range::finite(), "accelerometer bias x (not estimated, as in the paper)") \
+  FIELD(double, accel_bias_y_m_s2, 0.0, range::finite(), "accelerometer bias y (not estimated, as in the paper)") \
+  FIELD(double, accel_bias_z_m_s2, 0.0, range::finite(), "accelerometer bias z (not estimated, as in the paper)") \
+  FIELD(bool, accel_unit_detection, true, range::unchecked(), "detect an accelerometer reporting in g and scale it") \
+  FIELD(int, accel_unit_detection_samples, 50, range::at_least(1), "the mean |accel| of these first samples decides the unit")
+
+// ---- cuda: the CUDA backend's device buffers, allocated once when the pipeline starts ----------
+// A scan or map beyond them raises CapacityError naming the field to raise (docs/cuda.md).
+#define FARLIO_CUDA_FIELDS(FIELD)                                                                       \
+  FIELD(std::int64_t, max_scan_points, 1 << 19, range::at_least(1),                                    \
+        "device buffers: points of one scan, all LiDARs merged (racetrack: ~210k)")                    \
+  FIELD(std::int64_t, max_map_voxels, 1 << 18, range::between(1, kMaxVoxelCapacity),                   \
+        "device buffers: submap voxels (N_max points each)")                                           \
+  FIELD(std::int64_t, max_frame_voxels, 1 << 16, range::between(1, kMaxVoxelCapacity),                 \
+        "device buffers: voxels of the per-scan frame map")
+
+// ---- top level ---------------------------------------------------------------------------------
+#define FARLIO_TOP_FIELDS(FIELD)                                                                        \
+  FIELD(Device, device, Device::Auto, range::unchecked(),                                              \
+        "scan pipeline backend: auto (CUDA when a GPU is present, else CPU), cpu or cuda")             \
+  FIELD(int, num_threads, 0, range::non_negative(), "CPU threads of this pipeline instance (0: all)")
+
+#define FARLIO_CONFIG_MEMBER(type, name, default_value, valid, doc) type name = default_value;
+
 struct PreprocessConfig {
-  double min_range_m = 1.0;     ///< points closer than this to the sensor are dropped (vehicle body)
-  double max_range_m = 200.0;   ///< points farther than this are dropped
-  bool undistort = true;        ///< motion undistortion (MU) of points with per-point times
+  FARLIO_PREPROCESS_FIELDS(FARLIO_CONFIG_MEMBER)
 };
-
-/// The voxel hash map (cuVoxelMap): the adaptive local submap and the per-scan frame map.
 struct VoxelMapConfig {
-  double voxel_size_m = 4.0;           ///< v: edge of a voxel cube (paper: 4 m); the upper bound when auto
-  /// Scale the voxel to the scene at the first scan: v = clamp(p90 range / auto_range_ratio,
-  /// auto_min_voxel_size_m, voxel_size_m). Vehicles outdoors keep the paper's 4 m; rooms and
-  /// corridors get a finer map (a 4 m voxel spans a whole room).
-  bool auto_voxel_size = true;
-  double auto_range_ratio = 6.0;
-  double auto_min_voxel_size_m = 1.0;
-  int max_points_per_voxel = 40;       ///< N_max (paper: 40)
-  /// Minimum distance between points of a voxel; 0: sqrt(v^2 / N_max) (~0.63 m by default).
-  double point_spacing_m = 0.0;
-  int covariance_neighbors = 10;       ///< k nearest neighbours for a point covariance (paper: 10)
-  double covariance_epsilon = 1e-3;    ///< C = Sigma_hat + eps * I before Frobenius normalisation (eq. 1)
-  /// A covariance is line-like when, after regularisation, its middle eigenvalue is below this
-  /// ratio times the smallest while the largest is above it (points along one scan line or a
-  /// pole). 0: never classify (every covariance counts as a surface).
-  double line_eigenvalue_ratio = 10.0;
-  double removal_radius_m = 1000.0;    ///< voxels whose centre is farther from the pose are removed
-  /// Recompute the covariances of existing points in voxels that received new points (the
-  /// reference never refreshes them).
-  bool refresh_covariances = true;
-  std::int64_t initial_voxel_capacity = 1 << 14;  ///< voxels preallocated; doubles as needed
-  std::int64_t max_voxel_capacity = 1 << 20;      ///< growth beyond this raises CapacityError
+  FARLIO_MAP_FIELDS(FARLIO_CONFIG_MEMBER)
 };
-
-/// Adaptive submap density (ASMD): the per-voxel point limit follows the scan's density.
 struct AdaptiveDensityConfig {
-  bool enabled = true;
-  double close_range_m = 20.0;          ///< density is averaged over frame-map voxels within this range
-  double slope_points_per_m = 0.03;     ///< linear decay of the limit beyond close_range_m
-  int frame_map_max_points_per_voxel = 20;  ///< cap of the per-scan frame map (reference: 20)
+  FARLIO_DENSITY_FIELDS(FARLIO_CONFIG_MEMBER)
 };
-
-/// KISS-ICP-style adaptive correspondence threshold.
 struct ThresholdConfig {
-  double initial_threshold_m = 1.0;     ///< sigma before any model deviation is observed
-  double min_motion_m = 0.25;           ///< deviations below this are not sampled
-  double max_range_m = 100.0;           ///< turns a rotation error into a translation error
-  double max_threshold_m = 10.0;        ///< sigma is capped here
+  FARLIO_THRESHOLD_FIELDS(FARLIO_CONFIG_MEMBER)
 };
-
-/// Sparsity-aware GICP (scan to submap).
 struct RegistrationConfig {
-  bool sparsity_aware = true;           ///< GICP (true) or plain point-to-point ICP for every point (false)
-  /// Points without a covariance (too few neighbours) enter as point-to-point factors whose
-  /// residual has this standard deviation per axis; 0: half the map's point spacing (the matched
-  /// sample may lie that far away: 32 cm at 4 m voxels). The paper weights them like a
-  /// surface's normal (Omega = I, i.e. sqrt(map.covariance_epsilon) = 3.2 cm), which lets a few far
-  /// points matched to their own earlier samples pin a scan to a standstill (docs/odometry.md).
-  double point_to_point_sigma_m = 0.0;
-  /// Leave out correspondences whose two covariances are both line-like (map.line_eigenvalue_ratio):
-  /// two scan lines recorded from the same place fake a constraint across the line.
-  bool skip_line_pairs = true;
-  int max_iterations = 500;
-  double convergence_norm = 5e-3;       ///< stop when |dx| (6-vector, m and rad) falls below this
-  double time_budget_factor = 2.0;      ///< time budget = factor * LiDAR period (paper: 2)
-  double damping = 1e-9;                ///< lambda added to the diagonal of H
+  FARLIO_REGISTRATION_FIELDS(FARLIO_CONFIG_MEMBER)
 };
-
-/// Sensor fusion: the kinematic EKF (paper eqs. 7-10) that fuses IMU inputs with LiDAR poses.
-/// Variances are given as standard deviations (unit in the name); docs/fusion.md explains each.
 struct FusionConfig {
-  bool enabled = true;                   ///< fuse the IMU (LIO); false or no IMU: LiDAR-only odometry
-  double step_s = 0.01;                  ///< fixed EKF step (paper: 100 Hz)
-  double history_s = 1.0;                ///< state history for delay compensation and pose queries
-  double max_extrapolation_s = 0.1;      ///< pose_at() may predict this far beyond the newest step
-  double imu_gap_limit_s = 0.1;          ///< IMU samples farther apart are a gap: the last input is held
-  // Input noise: std of the IMU input averaged over one step, mapped into the state as B Q B^T
-  // (reference: variances 3e-4..3e-3 rad^2/s^2 and 1.0..4.0 m^2/s^4 at 100 Hz).
-  double gyro_input_std_rad_s = 0.02;
-  double accel_input_std_m_s2 = 1.0;
-  // Initial covariance (the first LiDAR pose initialises the state).
-  double initial_position_std_m = 0.1;
-  double initial_attitude_std_rad = 0.02;
-  double initial_velocity_std_m_s = 20.0;  ///< used when the first LiDAR result carries no velocity
-  // LiDAR measurement noise (std per axis).
-  double lidar_position_std_m = 0.05;
-  double lidar_roll_pitch_std_rad = 0.02;
-  double lidar_yaw_std_rad = 0.01;
-  double lidar_velocity_std_m_s = 0.8;
-  // Mahalanobis outlier rejection per measurement group.
-  bool outlier_rejection = true;
-  double outlier_chi2_3dof = 16.27;      ///< chi-square 99.9 % quantile, 3 degrees of freedom
-  double outlier_chi2_2dof = 13.82;      ///< chi-square 99.9 % quantile, 2 degrees of freedom
-  int max_consecutive_rejections = 10;   ///< then the filter re-initialises from the LiDAR pose
-  // Roll/pitch reference angles (pseudo-measurement from gravity in the body frame).
-  bool reference_angles = true;
-  double reference_roll_std_rad = 0.22;  ///< reference: variance 0.05 rad^2
-  double reference_pitch_std_rad = 0.32; ///< reference: variance 0.1 rad^2
-  int reference_filter_taps = 11;        ///< Hann low-pass on v_dot and the IMU terms (odd)
-  double reference_max_sin = 0.5;        ///< asin argument clamp (30 deg); clamped values are not fused
-  // Delay compensation (eq. 10) and upsampling of LiDAR results.
-  bool delay_compensation = true;
-  int update_spread_steps = 0;           ///< N injections with N*R each; 0: LiDAR period / step_s
-  int max_update_spread_steps = 20;      ///< cap of the automatic N
-  // Gyro bias at standstill (the accelerometer bias stays at its initial value, as in the paper).
-  bool standstill_bias = true;
-  double standstill_max_speed_m_s = 0.4;
-  double standstill_max_gyro_rad_s = 0.05;
-  double standstill_max_accel_deviation_m_s2 = 1.0;  ///< | |a| - g | below this
-  int bias_window_samples = 10000;       ///< running mean over at most this many samples
-  int bias_prior_samples = 100;          ///< weight of the initial bias in the mean, in samples
-  double gyro_bias_init_x_rad_s = 0.0;
-  double gyro_bias_init_y_rad_s = 0.0;
-  double gyro_bias_init_z_rad_s = 0.0;
-  double accel_bias_x_m_s2 = 0.0;
-  double accel_bias_y_m_s2 = 0.0;
-  double accel_bias_z_m_s2 = 0.0;
-  // Accelerometer unit detection (IMUs reporting in g).
-  bool accel_unit_detection = true;
-  int accel_unit_detection_samples = 50; ///< mean |a| over these first samples decides the unit
+  FARLIO_FUSION_FIELDS(FARLIO_CONFIG_MEMBER)
 };
-
-/// The CUDA backend's device buffers, all allocated once when the pipeline starts (docs/cuda.md).
-/// A scan or map beyond them raises CapacityError naming the field to raise.
 struct CudaConfig {
-  std::int64_t max_scan_points = 1 << 19;    ///< points of one scan, all LiDARs merged (racetrack: ~210k)
-  std::int64_t max_map_voxels = 1 << 18;     ///< submap voxels on the device (N_max points each)
-  std::int64_t max_frame_voxels = 1 << 16;   ///< voxels of the per-scan frame map
+  FARLIO_CUDA_FIELDS(FARLIO_CONFIG_MEMBER)
 };
 
 struct Config {
@@ -146,8 +193,9 @@ struct Config {
   RegistrationConfig registration;
   FusionConfig fusion;
   CudaConfig cuda;
-  Device device = Device::Auto;         ///< backend of the scan pipeline: auto (CUDA if a GPU is present), cpu, cuda
-  int num_threads = 0;                  ///< CPU threads of this pipeline instance (0: all)
+  FARLIO_TOP_FIELDS(FARLIO_CONFIG_MEMBER)
 };
+
+#undef FARLIO_CONFIG_MEMBER
 
 }  // namespace farlio

@@ -2,100 +2,41 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <sstream>
 #include <stdexcept>
 
 namespace farlio {
-
-std::vector<ConfigField> config_fields(Config& c) {
-  return {
-      {"preprocess.min_range_m", &c.preprocess.min_range_m, "points closer to the sensor are dropped"},
-      {"preprocess.max_range_m", &c.preprocess.max_range_m, "points farther from the sensor are dropped"},
-      {"preprocess.undistort", &c.preprocess.undistort, "motion undistortion of points with per-point times"},
-      {"map.voxel_size_m", &c.map.voxel_size_m, "edge of a voxel of the submap (paper: 4 m)"},
-      {"map.auto_voxel_size", &c.map.auto_voxel_size,
-       "scale the voxel to the first scan: clamp(p90 range / auto_range_ratio, auto_min_voxel_size_m, voxel_size_m)"},
-      {"map.auto_range_ratio", &c.map.auto_range_ratio, "p90 range of the first scan over the voxel size (auto)"},
-      {"map.auto_min_voxel_size_m", &c.map.auto_min_voxel_size_m, "smallest voxel the auto scaling picks"},
-      {"map.max_points_per_voxel", &c.map.max_points_per_voxel,
-       "N_max; the point spacing is voxel_size_m / sqrt(N_max) (paper: 40)"},
-      {"map.point_spacing_m", &c.map.point_spacing_m, "minimum point distance in a voxel; 0: voxel_size_m / sqrt(N_max)"},
-      {"map.covariance_neighbors", &c.map.covariance_neighbors, "k nearest neighbours of a covariance (paper: 10)"},
-      {"map.covariance_epsilon", &c.map.covariance_epsilon, "eps of the Frobenius regularisation, eq. (1)"},
-      {"map.line_eigenvalue_ratio", &c.map.line_eigenvalue_ratio,
-       "a covariance is line-like when its middle eigenvalue is below ratio x the smallest (0: off)"},
-      {"map.removal_radius_m", &c.map.removal_radius_m, "voxels farther than this from the pose are removed"},
-      {"map.refresh_covariances", &c.map.refresh_covariances,
-       "recompute covariances of existing points in voxels that receive new points"},
-      {"map.initial_voxel_capacity", &c.map.initial_voxel_capacity, "voxels preallocated (grows by doubling)"},
-      {"map.max_voxel_capacity", &c.map.max_voxel_capacity, "hard limit of the submap in voxels"},
-      {"density.enabled", &c.density.enabled, "adaptive submap density (ASMD)"},
-      {"density.close_range_m", &c.density.close_range_m, "range over which the scan's density is averaged"},
-      {"density.slope_points_per_m", &c.density.slope_points_per_m, "linear decay of the per-voxel limit with range"},
-      {"density.frame_map_max_points_per_voxel", &c.density.frame_map_max_points_per_voxel,
-       "cap of the per-scan frame map (source covariances)"},
-      {"threshold.initial_threshold_m", &c.threshold.initial_threshold_m, "sigma before any deviation is observed"},
-      {"threshold.min_motion_m", &c.threshold.min_motion_m, "model deviations below this are not sampled"},
-      {"threshold.max_range_m", &c.threshold.max_range_m, "range that turns a rotation into a displacement"},
-      {"threshold.max_threshold_m", &c.threshold.max_threshold_m, "cap of sigma"},
-      {"registration.sparsity_aware", &c.registration.sparsity_aware, "GICP (true) or point-to-point ICP (false)"},
-      {"registration.point_to_point_sigma_m", &c.registration.point_to_point_sigma_m,
-       "residual sigma of points without covariance (point-to-point); 0: half the map spacing; paper: 0.0316"},
-      {"registration.skip_line_pairs", &c.registration.skip_line_pairs,
-       "leave out correspondences whose covariances are both line-like"},
-      {"registration.max_iterations", &c.registration.max_iterations, "Gauss-Newton iterations at most"},
-      {"registration.convergence_norm", &c.registration.convergence_norm, "stop when |dx| falls below this"},
-      {"registration.time_budget_factor", &c.registration.time_budget_factor, "time budget in LiDAR periods"},
-      {"registration.damping", &c.registration.damping, "lambda added to the diagonal of H"},
-      {"fusion.enabled", &c.fusion.enabled, "fuse the IMU (LIO); false or no IMU: LiDAR-only odometry"},
-      {"fusion.step_s", &c.fusion.step_s, "fixed EKF step (paper: 0.01 s = 100 Hz)"},
-      {"fusion.history_s", &c.fusion.history_s, "state history kept for delay compensation and pose queries"},
-      {"fusion.max_extrapolation_s", &c.fusion.max_extrapolation_s, "pose_at() may predict this far beyond the newest step"},
-      {"fusion.imu_gap_limit_s", &c.fusion.imu_gap_limit_s, "IMU samples farther apart are a gap: the last input is held"},
-      {"fusion.gyro_input_std_rad_s", &c.fusion.gyro_input_std_rad_s, "std of the gyro input over one step (process noise B Q B^T)"},
-      {"fusion.accel_input_std_m_s2", &c.fusion.accel_input_std_m_s2, "std of the accelerometer input over one step (process noise B Q B^T)"},
-      {"fusion.initial_position_std_m", &c.fusion.initial_position_std_m, "initial position std at initialisation"},
-      {"fusion.initial_attitude_std_rad", &c.fusion.initial_attitude_std_rad, "initial roll/pitch/yaw std at initialisation"},
-      {"fusion.initial_velocity_std_m_s", &c.fusion.initial_velocity_std_m_s, "initial velocity std when the first LiDAR result has no velocity"},
-      {"fusion.lidar_position_std_m", &c.fusion.lidar_position_std_m, "LiDAR position measurement std per axis"},
-      {"fusion.lidar_roll_pitch_std_rad", &c.fusion.lidar_roll_pitch_std_rad, "LiDAR roll and pitch measurement std"},
-      {"fusion.lidar_yaw_std_rad", &c.fusion.lidar_yaw_std_rad, "LiDAR yaw measurement std"},
-      {"fusion.lidar_velocity_std_m_s", &c.fusion.lidar_velocity_std_m_s, "LiDAR body velocity (eq. 6) measurement std per axis"},
-      {"fusion.outlier_rejection", &c.fusion.outlier_rejection, "Mahalanobis outlier rejection per measurement group"},
-      {"fusion.outlier_chi2_3dof", &c.fusion.outlier_chi2_3dof, "chi-square gate for 3-dof groups (99.9 %: 16.27)"},
-      {"fusion.outlier_chi2_2dof", &c.fusion.outlier_chi2_2dof, "chi-square gate for 2-dof groups (99.9 %: 13.82)"},
-      {"fusion.max_consecutive_rejections", &c.fusion.max_consecutive_rejections, "consecutive rejected LiDAR positions before re-initialising from LiDAR"},
-      {"fusion.reference_angles", &c.fusion.reference_angles, "fuse roll/pitch reference angles (ablation switch)"},
-      {"fusion.reference_roll_std_rad", &c.fusion.reference_roll_std_rad, "reference roll angle measurement std"},
-      {"fusion.reference_pitch_std_rad", &c.fusion.reference_pitch_std_rad, "reference pitch angle measurement std"},
-      {"fusion.reference_filter_taps", &c.fusion.reference_filter_taps, "taps of the Hann low-pass of the reference angle terms (odd)"},
-      {"fusion.reference_max_sin", &c.fusion.reference_max_sin, "clamp of the asin argument; clamped reference angles are not fused"},
-      {"fusion.delay_compensation", &c.fusion.delay_compensation, "shift delayed measurements by eq. 10 (ablation switch)"},
-      {"fusion.update_spread_steps", &c.fusion.update_spread_steps, "N: a LiDAR result is fused over N steps with N*R each (0: LiDAR period / step)"},
-      {"fusion.max_update_spread_steps", &c.fusion.max_update_spread_steps, "cap of the automatic N"},
-      {"fusion.standstill_bias", &c.fusion.standstill_bias, "learn the gyro bias at standstill (ablation switch)"},
-      {"fusion.standstill_max_speed_m_s", &c.fusion.standstill_max_speed_m_s, "standstill: estimated speed below this"},
-      {"fusion.standstill_max_gyro_rad_s", &c.fusion.standstill_max_gyro_rad_s, "standstill: |gyro| below this"},
-      {"fusion.standstill_max_accel_deviation_m_s2", &c.fusion.standstill_max_accel_deviation_m_s2, "standstill: | |accel| - g | below this"},
-      {"fusion.bias_window_samples", &c.fusion.bias_window_samples, "gyro bias running-mean window in samples"},
-      {"fusion.bias_prior_samples", &c.fusion.bias_prior_samples, "weight of the initial gyro bias in the running mean, in samples"},
-      {"fusion.gyro_bias_init_x_rad_s", &c.fusion.gyro_bias_init_x_rad_s, "initial gyro bias x"},
-      {"fusion.gyro_bias_init_y_rad_s", &c.fusion.gyro_bias_init_y_rad_s, "initial gyro bias y"},
-      {"fusion.gyro_bias_init_z_rad_s", &c.fusion.gyro_bias_init_z_rad_s, "initial gyro bias z"},
-      {"fusion.accel_bias_x_m_s2", &c.fusion.accel_bias_x_m_s2, "accelerometer bias x (not estimated, as in the paper)"},
-      {"fusion.accel_bias_y_m_s2", &c.fusion.accel_bias_y_m_s2, "accelerometer bias y (not estimated, as in the paper)"},
-      {"fusion.accel_bias_z_m_s2", &c.fusion.accel_bias_z_m_s2, "accelerometer bias z (not estimated, as in the paper)"},
-      {"fusion.accel_unit_detection", &c.fusion.accel_unit_detection, "detect an accelerometer reporting in g and scale it"},
-      {"fusion.accel_unit_detection_samples", &c.fusion.accel_unit_detection_samples, "first samples whose mean |accel| decides the unit"},
-      {"cuda.max_scan_points", &c.cuda.max_scan_points, "device buffers: points of one scan (all LiDARs merged)"},
-      {"cuda.max_map_voxels", &c.cuda.max_map_voxels, "device buffers: submap voxels (N_max points each)"},
-      {"cuda.max_frame_voxels", &c.cuda.max_frame_voxels, "device buffers: voxels of the per-scan frame map"},
-      {"device", &c.device, "scan pipeline backend: auto (CUDA when a GPU is present, else CPU), cpu or cuda"},
-      {"num_threads", &c.num_threads, "CPU threads of this pipeline (0: all)"},
-  };
-}
-
 namespace {
+
+// One entry per field of a section's list in config.hpp; `section` and `prefix` are the
+// parameters of the function the list expands in.
+#define FARLIO_FIELD_ENTRY(type, name, default_value, valid, doc) \
+  out.push_back(ConfigField{prefix + #name, &section.name, doc, valid});
+#define FARLIO_SECTION_FIELDS(Section, LIST)                                                      \
+  void append_fields(std::vector<ConfigField>& out, Section& section, const std::string& prefix) { \
+    LIST(FARLIO_FIELD_ENTRY)                                                                       \
+  }
+
+FARLIO_SECTION_FIELDS(PreprocessConfig, FARLIO_PREPROCESS_FIELDS)
+FARLIO_SECTION_FIELDS(VoxelMapConfig, FARLIO_MAP_FIELDS)
+FARLIO_SECTION_FIELDS(AdaptiveDensityConfig, FARLIO_DENSITY_FIELDS)
+FARLIO_SECTION_FIELDS(ThresholdConfig, FARLIO_THRESHOLD_FIELDS)
+FARLIO_SECTION_FIELDS(RegistrationConfig, FARLIO_REGISTRATION_FIELDS)
+FARLIO_SECTION_FIELDS(FusionConfig, FARLIO_FUSION_FIELDS)
+FARLIO_SECTION_FIELDS(CudaConfig, FARLIO_CUDA_FIELDS)
+FARLIO_SECTION_FIELDS(Config, FARLIO_TOP_FIELDS)
+
+#undef FARLIO_SECTION_FIELDS
+#undef FARLIO_FIELD_ENTRY
+
+/// The fields of one section, named under `prefix` ("map" gives "map.voxel_size_m").
+template <typename Section>
+std::vector<ConfigField> section_fields(Section& section, const std::string& prefix) {
+  std::vector<ConfigField> out;
+  append_fields(out, section, prefix + ".");
+  return out;
+}
 
 std::size_t edit_distance(const std::string& a, const std::string& b) {
   std::vector<std::size_t> row(b.size() + 1);
@@ -137,45 +78,149 @@ T parse_number(const std::string& name, const std::string& text) {
   return v;
 }
 
-}  // namespace
+/// Shortest text that reads back to the same number ("inf", "nan" for those).
+template <typename T>
+std::string number_text(T v) {
+  char buf[64];
+  const auto r = std::to_chars(buf, buf + sizeof(buf), v);
+  return {buf, static_cast<std::size_t>(r.ptr - buf)};
+}
 
-void set_config_field(Config& config, const std::string& name, const std::string& value) {
-  const ConfigField f = find_field(config, name);
+bool parse_bool(const std::string& name, const std::string& text) {
+  if (text == "true" || text == "True" || text == "1") return true;
+  if (text == "false" || text == "False" || text == "0") return false;
+  throw std::invalid_argument("config field '" + name + "': expected true or false, got '" + text + "'");
+}
+
+/// Throws naming the field when its value lies outside its range.
+void check_range(const ConfigField& f) {
   std::visit(
       [&](auto* p) {
         using T = std::remove_pointer_t<decltype(p)>;
-        if constexpr (std::is_same_v<T, Device>) {
-          *p = parse_device(value, name);
-        } else if constexpr (std::is_same_v<T, bool>) {
-          if (value == "true" || value == "True" || value == "1") *p = true;
-          else if (value == "false" || value == "False" || value == "0") *p = false;
-          else throw std::invalid_argument("config field '" + name + "': expected true or false, got '" + value + "'");
-        } else {
-          *p = parse_number<T>(name, value);
+        if constexpr (!std::is_same_v<T, bool> && !std::is_same_v<T, Device>) {
+          if (!f.valid.contains(static_cast<double>(*p))) {
+            throw std::invalid_argument("config field '" + f.name + "' must be " + f.valid.describe() + ", got " +
+                                        number_text(*p));
+          }
         }
       },
       f.value);
 }
 
-std::string get_config_field(const Config& config, const std::string& name) {
-  Config copy = config;
-  const ConfigField f = find_field(copy, name);
-  std::ostringstream os;
+void require(bool holds, const std::string& rule) {
+  if (!holds) throw std::invalid_argument("config: " + rule);
+}
+
+template <typename Section>
+void check_ranges(const Section& section, const std::string& prefix) {
+  Section copy = section;
+  for (const ConfigField& f : section_fields(copy, prefix)) check_range(f);
+}
+
+}  // namespace
+
+bool FieldRange::contains(double v) const {
+  if (!checked) return true;
+  if (std::isnan(v)) return false;
+  if (std::isinf(v)) return v > 0 && allow_infinity;
+  return (min_exclusive ? v > min : v >= min) && v <= max;
+}
+
+std::string FieldRange::describe() const {
+  std::string s;
+  if (std::isinf(min) && std::isinf(max)) {
+    s = "finite";
+  } else if (std::isinf(max)) {
+    s = (min_exclusive ? "> " : ">= ") + number_text(min);
+  } else if (std::isinf(min)) {
+    s = "<= " + number_text(max);
+  } else {
+    s = "in " + std::string(min_exclusive ? "(" : "[") + number_text(min) + ", " + number_text(max) + "]";
+  }
+  return allow_infinity ? s + " or inf" : s;
+}
+
+std::vector<ConfigField> config_fields(Config& c) {
+  std::vector<ConfigField> out;
+  append_fields(out, c.preprocess, "preprocess.");
+  append_fields(out, c.map, "map.");
+  append_fields(out, c.density, "density.");
+  append_fields(out, c.threshold, "threshold.");
+  append_fields(out, c.registration, "registration.");
+  append_fields(out, c.fusion, "fusion.");
+  append_fields(out, c.cuda, "cuda.");
+  append_fields(out, c, "");
+  return out;
+}
+
+void set_config_field(Config& config, const std::string& name, const std::string& value) {
+  Config candidate = config;  // the config only changes when the new value is valid
+  const ConfigField target = find_field(candidate, name);
   std::visit(
       [&](auto* p) {
         using T = std::remove_pointer_t<decltype(p)>;
         if constexpr (std::is_same_v<T, Device>) {
-          os << device_name(*p);
+          *p = parse_device(value, "config field '" + name + "'");
         } else if constexpr (std::is_same_v<T, bool>) {
-          os << (*p ? "true" : "false");
+          *p = parse_bool(name, value);
         } else {
-          char buf[64];  // shortest text that reads back to the same value
-          const auto r = std::to_chars(buf, buf + sizeof(buf), *p);
-          os << std::string_view(buf, static_cast<std::size_t>(r.ptr - buf));
+          *p = parse_number<T>(name, value);
         }
       },
-      f.value);
-  return os.str();
+      target.value);
+  check_range(target);
+  config = candidate;
+}
+
+ConfigValue get_config_value(const Config& config, const std::string& name) {
+  Config copy = config;
+  const ConfigField f = find_field(copy, name);
+  return std::visit([](auto* p) { return ConfigValue(*p); }, f.value);
+}
+
+std::string get_config_field(const Config& config, const std::string& name) {
+  return std::visit(
+      [](auto v) -> std::string {
+        using T = decltype(v);
+        if constexpr (std::is_same_v<T, Device>) {
+          return device_name(v);
+        } else if constexpr (std::is_same_v<T, bool>) {
+          return v ? "true" : "false";
+        } else {
+          return number_text(v);
+        }
+      },
+      get_config_value(config, name));
+}
+
+void validate_config(const VoxelMapConfig& map, const std::string& prefix) {
+  check_ranges(map, prefix);
+  require(!map.auto_voxel_size || map.auto_min_voxel_size_m <= map.voxel_size_m,
+          prefix + ".auto_min_voxel_size_m must not exceed " + prefix + ".voxel_size_m (the largest auto voxel)");
+  require(map.initial_voxel_capacity <= map.max_voxel_capacity,
+          prefix + ".initial_voxel_capacity must not exceed " + prefix + ".max_voxel_capacity");
+}
+
+void validate_config(const FusionConfig& fusion) {
+  check_ranges(fusion, "fusion");
+  require(fusion.reference_filter_taps % 2 == 1, "fusion.reference_filter_taps must be odd");
+  require(fusion.history_s >= fusion.step_s, "fusion.history_s must hold at least one fusion.step_s");
+}
+
+void validate_config(const Config& config) {
+  check_ranges(config.preprocess, "preprocess");
+  require(config.preprocess.min_range_m < config.preprocess.max_range_m,
+          "preprocess.min_range_m must be below preprocess.max_range_m");
+  validate_config(config.map);
+  check_ranges(config.density, "density");
+  check_ranges(config.threshold, "threshold");
+  check_ranges(config.registration, "registration");
+  validate_config(config.fusion);
+  check_ranges(config.cuda, "cuda");
+  Config copy = config;
+  std::vector<ConfigField> top;
+  append_fields(top, copy, "");
+  for (const ConfigField& f : top) check_range(f);
 }
 
 }  // namespace farlio

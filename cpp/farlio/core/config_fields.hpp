@@ -1,13 +1,15 @@
 #pragma once
-// Every field of Config by its dotted name (e.g. "map.voxel_size_m"), with its documentation:
-// the one place through which YAML files, command-line overrides and the written effective
-// config reach the parameter set.
+// Every field of Config by its dotted name (e.g. "map.voxel_size_m"), with its documentation and
+// valid range, generated from the field lists of config.hpp: the one place through which YAML
+// files, command-line overrides, the written effective config and the bindings reach the
+// parameter set, and where it is validated.
 #include <cstdint>
 #include <string>
 #include <variant>
 #include <vector>
 
 #include "farlio/core/config.hpp"
+#include "farlio/core/config_range.hpp"
 
 namespace farlio {
 
@@ -15,16 +17,37 @@ struct ConfigField {
   std::string name;
   std::variant<double*, int*, std::int64_t*, bool*, Device*> value;
   std::string doc;
+  FieldRange valid;
 };
 
-/// The fields of `config` (pointers into it).
+/// A field's value with its type.
+using ConfigValue = std::variant<double, int, std::int64_t, bool, Device>;
+
+/// The fields of `config` (pointers into it), in the order of config.hpp.
 std::vector<ConfigField> config_fields(Config& config);
 
 /// Sets a field from its text form; throws std::invalid_argument naming the field (and the
-/// closest known names) when it is unknown or the value does not parse.
+/// closest known names) when it is unknown, the value does not parse or is out of its range.
 void set_config_field(Config& config, const std::string& name, const std::string& value);
 
-/// The field's value as text.
+/// The field's value as text (numbers in their shortest exact form).
 std::string get_config_field(const Config& config, const std::string& name);
+/// The field's value with its type.
+ConfigValue get_config_value(const Config& config, const std::string& name);
+
+/// Throws std::invalid_argument naming the first field out of its range (NaN included) or the
+/// fields of a rule between fields that does not hold (e.g. preprocess.min_range_m below
+/// preprocess.max_range_m).
+void validate_config(const Config& config);
+/// The checks of validate_config that concern one section, naming its fields under `prefix`.
+void validate_config(const VoxelMapConfig& map, const std::string& prefix = "map");
+void validate_config(const FusionConfig& fusion);
+
+/// `config` (a Config or a section above) after validate_config, for member initialisers.
+template <typename C>
+const C& validated(const C& config) {
+  validate_config(config);
+  return config;
+}
 
 }  // namespace farlio

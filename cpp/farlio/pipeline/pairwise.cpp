@@ -3,23 +3,23 @@
 #include <limits>
 #include <numeric>
 
+#include "farlio/core/config_fields.hpp"
 #include "farlio/map/voxel_map.hpp"
 #include "farlio/pipeline/preprocess.hpp"
+#include "farlio/pipeline/scan_backend.hpp"
 
 namespace farlio::pipeline {
 
 registration::RegistrationResult register_pair(const std::vector<Eigen::Vector3f>& source,
                                                const std::vector<Eigen::Vector3f>& target, const SE3& initial_guess,
                                                const Config& requested) {
-  Config config = requested;
+  Config config = validated(requested);
   config.map.voxel_size_m = scene_voxel_size_m(target, config.map);
   exec::CpuExecutor executor(config.num_threads);
   map::VoxelMap target_map(config.map, executor);
   target_map.insert(target, Eigen::Vector3f::Zero(), map::PointLimit::constant(config.map.max_points_per_voxel));
 
-  VoxelMapConfig frame_cfg = config.map;
-  frame_cfg.point_spacing_m = map::point_spacing_m(config.map);
-  frame_cfg.max_points_per_voxel = config.density.frame_map_max_points_per_voxel;
+  const VoxelMapConfig frame_cfg = frame_map_config(config);
   map::VoxelMap frame(frame_cfg, executor);
   std::vector<std::int32_t> all(source.size());
   std::iota(all.begin(), all.end(), 0);

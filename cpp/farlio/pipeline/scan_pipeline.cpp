@@ -5,6 +5,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "farlio/core/config_fields.hpp"
+#include "farlio/core/time.hpp"
 #include "farlio/pipeline/preprocess.hpp"
 
 namespace farlio::pipeline {
@@ -15,12 +17,11 @@ double seconds_since(Clock::time_point t) { return std::chrono::duration<double>
 
 // Used as the LiDAR period when neither stamps nor per-point times give one (10 Hz).
 constexpr double kFallbackPeriod_s = 0.1;
-constexpr double kNsPerS = 1e9;
 
 }  // namespace
 
 ScanPipeline::ScanPipeline(const Config& config, const SE3& initial_pose)
-    : config_(config),
+    : config_(validated(config)),
       backend_(make_scan_backend(config, &device_message_)),
       threshold_(config.threshold),
       initial_pose_(initial_pose),
@@ -34,13 +35,13 @@ void ScanPipeline::reset_initial_pose(const SE3& initial_pose) {
 
 registration::Vec6d ScanPipeline::last_twist() const {
   if (frames_ < 2 || last_stamp_ns_ <= prev_stamp_ns_) return registration::Vec6d::Zero();
-  const double dt = static_cast<double>(last_stamp_ns_ - prev_stamp_ns_) / kNsPerS;
+  const double dt = ns_to_seconds(last_stamp_ns_ - prev_stamp_ns_);
   return (prev_pose_.inverse() * last_pose_).log() / dt;
 }
 
 SE3 ScanPipeline::predict(std::int64_t stamp_ns) const {
   if (frames_ == 0) return initial_pose_;
-  const double dt = static_cast<double>(stamp_ns - last_stamp_ns_) / kNsPerS;
+  const double dt = ns_to_seconds(stamp_ns - last_stamp_ns_);
   return last_pose_ * SE3::exp(last_twist() * dt);
 }
 
@@ -91,7 +92,7 @@ FrameResult ScanPipeline::process(const Scan& scan, const std::optional<SE3>& in
   // 3. registration against the submap
   t0 = Clock::now();
   const double period_s = frames_ > 0 && scan.end_stamp_ns > last_stamp_ns_
-                              ? static_cast<double>(scan.end_stamp_ns - last_stamp_ns_) / kNsPerS
+                              ? ns_to_seconds(scan.end_stamp_ns - last_stamp_ns_)
                               : (scan.duration_s() > 0 ? scan.duration_s() : kFallbackPeriod_s);
   out.initial_guess = initial_guess ? *initial_guess : predict(scan.end_stamp_ns);
   out.sigma_m = threshold_.sigma_m();
@@ -119,7 +120,7 @@ FrameResult ScanPipeline::process(const Scan& scan, const std::optional<SE3>& in
 
   // 5. velocity from consecutive poses (eq. 6) and the constant-velocity state
   if (frames_ > 0 && scan.end_stamp_ns > last_stamp_ns_) {
-    const double dt = static_cast<double>(scan.end_stamp_ns - last_stamp_ns_) / kNsPerS;
+    const double dt = ns_to_seconds(scan.end_stamp_ns - last_stamp_ns_);
     out.velocity_body_m_s = velocity_from_poses(last_pose_, pose, dt);
     out.angular_velocity_body_rad_s = (last_pose_.inverse() * pose).log().tail<3>() / dt;
   }

@@ -1,0 +1,74 @@
+"""The parameter set from Python: typed values, validation naming the field, the YAML round trip."""
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from farlio import _core
+from farlio.config import config_to_yaml, load_config
+
+
+def test_values_keep_their_types():
+    cfg = _core.Config()
+    assert cfg.get("num_threads") == 0 and type(cfg.get("num_threads")) is int
+    assert cfg.get("map.voxel_size_m") == 4.0 and type(cfg.get("map.voxel_size_m")) is float
+    assert cfg.get("density.enabled") is True
+    assert cfg.get("device") == "auto"
+    d = cfg.to_dict()
+    assert d["map.max_voxel_capacity"] == 1 << 20
+    assert all(not isinstance(v, str) for k, v in d.items() if k != "device")
+
+
+def test_set_takes_numbers_bools_and_text():
+    cfg = _core.Config()
+    cfg.set("map.voxel_size_m", 2)
+    cfg.set("density.enabled", False)
+    cfg.set("registration.max_iterations", "7")
+    cfg.set("map.removal_radius_m", math.inf)
+    assert cfg.get("map.voxel_size_m") == 2.0
+    assert cfg.get("density.enabled") is False
+    assert cfg.get("registration.max_iterations") == 7
+    assert math.isinf(cfg.get("map.removal_radius_m"))
+    assert repr(cfg) == ("Config(map.voxel_size_m=2, map.removal_radius_m=inf, density.enabled=false, "
+                         "registration.max_iterations=7)")
+    assert repr(_core.Config()) == "Config(defaults)"
+
+
+@pytest.mark.parametrize("name,value", [("fusion.step_s", 0), ("map.voxel_size_m", -1.0),
+                                        ("preprocess.min_range_m", math.nan), ("registration.max_iterations", 2.5),
+                                        ("num_threads", -1)])
+def test_a_bad_value_is_an_error_naming_the_field_and_leaves_the_config(name, value):
+    cfg = _core.Config()
+    before = cfg.get(name)
+    with pytest.raises(ValueError, match=name.replace(".", r"\.")):
+        cfg.set(name, value)
+    assert cfg.get(name) == before
+
+
+def test_rules_between_fields_are_checked_when_loading(tmp_path):
+    with pytest.raises(ValueError, match="preprocess.min_range_m must be below preprocess.max_range_m"):
+        load_config(overrides=["preprocess.min_range_m=300"])
+    f = tmp_path / "bad.yaml"
+    f.write_text("fusion:\n  reference_filter_taps: 4\n")
+    with pytest.raises(ValueError, match="reference_filter_taps must be odd"):
+        load_config(f)
+
+
+def test_the_written_yaml_reads_back_to_the_same_config(tmp_path):
+    cfg = load_config(overrides=["map.voxel_size_m=2.5", "fusion.enabled=false", "registration.damping=1e-7",
+                                 "device=cpu", "registration.time_budget_factor=inf"])
+    f = tmp_path / "config.yaml"
+    f.write_text(config_to_yaml(cfg))
+    back = load_config(f)
+    assert back == cfg
+    assert back != _core.Config()
+
+
+def test_fields_list_defaults_docs_and_ranges():
+    fields = _core.Config.fields()
+    names = [f[0] for f in fields]
+    assert len(names) == len(set(names)) == len(_core.Config().to_dict())
+    by_name = {f[0]: f for f in fields}
+    assert by_name["fusion.step_s"][1:] == (0.01, by_name["fusion.step_s"][2], "in [1e-04, 1]")
+    assert all(doc for _, _, doc, _ in fields)
