@@ -138,6 +138,10 @@ TEST(OnlineOdometry, LockstepFromTwoThreadsEqualsTheReplay) {
   for (std::size_t i = 0; i < frames.size(); ++i) {
     EXPECT_TRUE(frames[i].processed);
     EXPECT_LT((frames[i].body_pose.translation() - expected_scans[i].translation()).norm(), 1e-6) << "scan " << i;
+    // on the odometry's clock (the newest IMU stamp): the scan's IMU was pushed before the scan
+    EXPECT_GT(frames[i].started_ns, rec.scans[i].start_stamp_ns) << "scan " << i;
+    EXPECT_LE(frames[i].started_ns, rec.scans[i].end_stamp_ns) << "scan " << i;
+    EXPECT_GE(frames[i].available_ns, frames[i].started_ns) << "scan " << i;
   }
   ASSERT_GT(expected.size(), 100u);  // 100 Hz over ~1.5 s
   ASSERT_EQ(got.size(), expected.size());
@@ -205,4 +209,23 @@ TEST(Replay, ResultsArrivingAfterTheLastImuSampleAreNoImuGap) {
   EXPECT_EQ(replay.fusion_stats()->imu_gaps, 0);
   EXPECT_GE(fused, 3);
   EXPECT_LE(last_output_ns, rec.imu.back().stamp_ns);  // no odometry beyond the data
+}
+
+TEST(Odometry, AZeroFusionStepIsAnErrorNamingTheField) {
+  const Recording& rec = recording();
+  Config config = deterministic_config();
+  config.fusion.step_s = 0.0;
+  for (const bool online : {false, true}) {
+    try {
+      if (online) {
+        OnlineOdometry o(config, rec.T_imu_lidar, rec.gravity_m_s2);
+      } else {
+        Odometry o(config, rec.T_imu_lidar, rec.gravity_m_s2, rec.imu);
+        o.process(rec.scans.front());
+      }
+      ADD_FAILURE() << (online ? "online" : "replay") << ": a zero step was accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("fusion.step_s"), std::string::npos) << e.what();
+    }
+  }
 }

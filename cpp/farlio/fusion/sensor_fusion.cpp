@@ -5,11 +5,12 @@
 #include <utility>
 #include <vector>
 
+#include "farlio/core/config_fields.hpp"
+#include "farlio/core/time.hpp"
 #include "farlio/fusion/euler.hpp"
 
 namespace farlio::fusion {
 namespace {
-constexpr double kNsPerS = 1e9;
 constexpr std::size_t kExtraHistoryEntries = 2;  ///< both ends of the history span
 
 double square(double v) { return v * v; }
@@ -32,9 +33,9 @@ struct LidarGroup {
 }  // namespace
 
 SensorFusion::SensorFusion(const FusionConfig& config, double gravity_m_s2)
-    : config_(config),
+    : config_(validated(config)),
       gravity_m_s2_(gravity_m_s2),
-      step_ns_(std::max<std::int64_t>(1, std::llround(config.step_s * kNsPerS))),
+      step_ns_(seconds_to_ns(config.step_s)),
       ekf_(gravity_m_s2, input_variance(config)),
       imu_(config.imu_gap_limit_s, config.history_s),
       accel_unit_(config.accel_unit_detection, config.accel_unit_detection_samples, gravity_m_s2),
@@ -100,7 +101,7 @@ void SensorFusion::step() {
   } else {
     in_gap_ = false;
   }
-  ekf_.predict(u0, um, u1, static_cast<double>(step_ns_) / kNsPerS);
+  ekf_.predict(u0, um, u1, ns_to_seconds(step_ns_));
   time_ns_ = t1;
   const StateVector before_injections = ekf_.state();
   queue_.inject(ekf_);
@@ -236,7 +237,6 @@ BodyEstimate SensorFusion::estimate() const {
   e.stamp_ns = time_ns_;
   e.pose = pose_of(x);
   e.velocity_body_m_s = x.segment<3>(kVelocityIndex);
-  e.covariance_diagonal = ekf_.covariance().diagonal();
   return e;
 }
 
@@ -244,7 +244,7 @@ std::optional<SE3> SensorFusion::pose_at(std::int64_t stamp_ns) const {
   if (!initialized() || history_.empty()) return std::nullopt;
   if (const auto x = history_.state_at(stamp_ns)) return pose_of(*x);
   const StampedState& newest = history_.newest();
-  const double ahead_s = static_cast<double>(stamp_ns - newest.stamp_ns) / kNsPerS;
+  const double ahead_s = ns_to_seconds(stamp_ns - newest.stamp_ns);
   if (ahead_s <= 0.0 || ahead_s > config_.max_extrapolation_s) return std::nullopt;
   return pose_of(integrate_step(newest.x, last_input_, last_input_, last_input_, ahead_s, gravity_m_s2_));
 }

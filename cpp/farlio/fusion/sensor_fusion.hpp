@@ -26,8 +26,6 @@ struct BodyEstimate {
   std::int64_t stamp_ns = 0;             ///< the filter time (the last step)
   SE3 pose;                              ///< body -> world
   Eigen::Vector3d velocity_body_m_s = Eigen::Vector3d::Zero();
-  /// Variances of [p (m^2), roll/pitch/yaw (rad^2), v_body (m^2/s^2)].
-  Eigen::Matrix<double, kStateDim, 1> covariance_diagonal = Eigen::Matrix<double, kStateDim, 1>::Zero();
 };
 
 struct FusionStats {
@@ -71,6 +69,8 @@ class SensorFusion {
                               const Eigen::Vector3d& body_velocity_m_s, bool use_velocity);
 
   [[nodiscard]] bool initialized() const { return ekf_.initialized(); }
+  /// The filter step (FusionConfig::step_s) in ns.
+  [[nodiscard]] std::int64_t step_ns() const { return step_ns_; }
   [[nodiscard]] BodyEstimate estimate() const;
   /// The pose at stamp_ns from the history, or predicted with the last input up to
   /// max_extrapolation_s beyond the newest step; nullopt otherwise.

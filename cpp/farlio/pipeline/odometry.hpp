@@ -19,9 +19,10 @@
 #include <vector>
 
 #include "farlio/core/config.hpp"
-#include "farlio/core/trajectory.hpp"
 #include "farlio/core/types.hpp"
 #include "farlio/fusion/sensor_fusion.hpp"
+#include "farlio/pipeline/fusion_driver.hpp"
+#include "farlio/pipeline/odometry_output.hpp"
 #include "farlio/pipeline/scan_pipeline.hpp"
 
 namespace farlio::pipeline {
@@ -32,25 +33,6 @@ struct ReplayOptions {
   LatencyModel latency = LatencyModel::Measured;
   double fixed_latency_s = 0.0;   ///< with LatencyModel::Fixed
   double added_delay_s = 0.0;     ///< added to every result's latency (latency sweeps)
-};
-
-/// What happened to one scan.
-struct OdometryFrame {
-  FrameResult scan;                   ///< the scan pipeline's result (LiDAR pose, timings, ...)
-  SE3 body_pose;                      ///< registered body pose at the scan end
-  bool processed = false;             ///< false: dropped before registration (pipeline busy)
-  bool fused = false;                 ///< the result reached the fusion
-  std::string drop_reason;            ///< why it was not processed or not fused
-  std::int64_t started_ns = 0;        ///< when the pipeline started on it (simulated clock)
-  std::int64_t available_ns = 0;      ///< when its result reached the fusion
-  bool guess_from_fusion = false;     ///< initial guess and undistortion came from the fusion
-};
-
-/// One sample of the 100 Hz odometry output.
-struct OdometrySample {
-  std::int64_t stamp_ns = 0;
-  SE3 body_pose;
-  Eigen::Vector3d velocity_body_m_s = Eigen::Vector3d::Zero();
 };
 
 class Odometry {
@@ -67,7 +49,7 @@ class Odometry {
   /// Called for every 10 ms odometry sample (LIO) as the clock advances.
   std::function<void(const OdometrySample&)> on_odometry;
 
-  [[nodiscard]] bool inertial() const { return fusion_.has_value(); }
+  [[nodiscard]] bool inertial() const { return driver_.inertial(); }
   [[nodiscard]] const ScanPipeline& scan_pipeline() const { return pipeline_; }
   [[nodiscard]] std::optional<fusion::FusionStats> fusion_stats() const;
   /// The body pose the world frame starts from (roll and pitch from gravity when inertial, set
@@ -78,19 +60,17 @@ class Odometry {
   void advance_clock(std::int64_t stamp_ns);
   [[nodiscard]] double latency_s(const FrameResult& r) const;
 
-  Config config_;
   ReplayOptions options_;
   SE3 T_imu_lidar_, T_lidar_imu_;
   SE3 initial_body_pose_;
   std::vector<ImuSample> imu_;
   std::size_t next_imu_ = 0;
-  std::optional<fusion::SensorFusion> fusion_;
+  FusionDriver driver_;
   ScanPipeline pipeline_;
   bool clock_started_ = false;
   std::int64_t clock_ns_ = 0;
-  std::int64_t next_output_ns_ = 0;
   std::int64_t busy_until_ns_ = 0;
-  std::optional<StampedPose> last_body_;
+  FusionDriver::Samples outputs_;  ///< reused buffer of the odometry samples of one clock advance
 };
 
 }  // namespace farlio::pipeline

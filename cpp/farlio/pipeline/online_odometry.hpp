@@ -2,7 +2,7 @@
 // LiDAR-inertial odometry for a live robot: IMU samples and scans are pushed from any thread as
 // they arrive, the scan pipeline runs on its own worker thread, and the fused 100 Hz odometry
 // comes out through a callback. The logic between the scan pipeline and the fusion is the
-// replay's (fusion_link.hpp); only the clock differs: here time is the newest IMU stamp, and a
+// replay's (fusion_driver.hpp); only the clock differs: here time is the newest IMU stamp, and a
 // scan's result is fused when its registration finishes, as a delayed measurement.
 //
 // Threads: add_imu() and add_scan() may be called from any threads (each kind in time order).
@@ -20,10 +20,10 @@
 #include <vector>
 
 #include "farlio/core/config.hpp"
-#include "farlio/core/trajectory.hpp"
 #include "farlio/core/types.hpp"
 #include "farlio/fusion/sensor_fusion.hpp"
-#include "farlio/pipeline/odometry.hpp"
+#include "farlio/pipeline/fusion_driver.hpp"
+#include "farlio/pipeline/odometry_output.hpp"
 #include "farlio/pipeline/scan_pipeline.hpp"
 
 namespace farlio::pipeline {
@@ -65,11 +65,8 @@ class OnlineOdometry {
 
   // fusion state, guarded by state_mutex_
   mutable std::mutex state_mutex_;
-  std::optional<fusion::SensorFusion> fusion_;
-  std::vector<ImuSample> startup_imu_;  // the first kGravityAlignmentWindow_s, for the start pose
-  bool inertial_decided_ = false, inertial_ = false;
-  std::int64_t next_output_ns_ = 0;
-  std::optional<StampedPose> last_body_;
+  FusionDriver driver_;
+  bool mode_decided_ = false;  ///< inertial or LiDAR-only, decided at the first scan
   std::size_t dropped_busy_ = 0;
 
   std::mutex emit_mutex_;  // keeps on_odometry calls in order

@@ -1,0 +1,93 @@
+#pragma once
+// Where the scan pipeline and the sensor fusion meet (paper Fig. 2): one object that both the
+// deterministic replay (odometry.hpp) and the threaded online odometry (online_odometry.hpp)
+// drive, so that the two cannot drift apart. They differ only in their clock: the replay feeds the
+// recording's IMU up to a simulated time, the online odometry each sample as it arrives.
+//   the fusion clock: IMU samples in, the EKF stepped, one odometry sample every fusion.step_s,
+//     each computed from exactly the IMU samples stamped up to its instant;
+//   before a scan: the start pose (roll and pitch from gravity) at the first scan, the fusion's
+//     pose at the scan end as the initial guess, and a regression over its pose history during
+//     the scan as the motion for the undistortion;
+//   after a scan: the drop rules, then the registered body pose and the eq. (6) velocity go into
+//     the fusion as a (possibly delayed) measurement.
+// Without the fusion (LiDAR-only odometry) the clock is idle, the prior is empty and nothing is
+// fused; the drop rules still apply.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "farlio/core/config.hpp"
+#include "farlio/core/se3.hpp"
+#include "farlio/core/trajectory.hpp"
+#include "farlio/core/types.hpp"
+#include "farlio/deskew/scan_motion.hpp"
+#include "farlio/fusion/sensor_fusion.hpp"
+#include "farlio/pipeline/odometry_output.hpp"
+
+namespace farlio::pipeline {
+
+/// Roll and pitch that make the mean specific force of the first samples (the first
+/// kGravityAlignmentWindow_s, and none after until_ns: the first scan's end) point up; yaw 0.
+/// Identity without samples.
+SE3 gravity_aligned_start(const std::vector<ImuSample>& imu, std::int64_t until_ns);
+/// Samples that gravity_aligned_start averages: those within this window of the first.
+inline constexpr double kGravityAlignmentWindow_s = 0.2;
+
+/// What the fusion tells the scan pipeline about a scan; empty before the filter is initialised.
+struct ScanPrior {
+  std::optional<SE3> guess;                  ///< LiDAR pose at the scan end
+  std::optional<deskew::ScanMotion> motion;  ///< LiDAR motion during the scan
+};
+
+/// Why a scan's result must not reach the fusion; empty when it may.
+std::string drop_reason(const FrameResult& result, bool map_started);
+
+class FusionDriver {
+ public:
+  using Samples = std::vector<OdometrySample>;
+
+  /// With `inertial` false the driver runs LiDAR-only (no fusion).
+  FusionDriver(const FusionConfig& config, double gravity_m_s2, const SE3& T_imu_lidar, bool inertial);
+
+  /// Feeds one IMU sample (in time order): appends to `out` the odometry sample of every output
+  /// instant before the sample's stamp, then of the one at its stamp.
+  void add_imu(const ImuSample& sample, Samples& out);
+  /// Moves the fusion clock to stamp_ns without new IMU data, appending the odometry samples up
+  /// to it (the replay, past the last sample it has fed).
+  void advance_to(std::int64_t stamp_ns, Samples& out);
+  /// Runs LiDAR-only from now on (the online odometry, when no IMU sample came before the first scan).
+  void stop_fusion() { fusion_.reset(); }
+
+  [[nodiscard]] bool inertial() const { return fusion_.has_value(); }
+  /// Whether an IMU sample has been fed.
+  [[nodiscard]] bool has_imu() const { return !startup_imu_.empty(); }
+  /// The newest IMU stamp fed, or the latest advance_to stamp (0 before either).
+  [[nodiscard]] std::int64_t clock_ns() const { return clock_ns_; }
+  /// The body pose the world frame starts from, for a first scan ending at first_scan_end_ns:
+  /// roll and pitch from gravity when inertial (gravity_aligned_start), else the identity.
+  [[nodiscard]] SE3 start_pose(std::int64_t first_scan_end_ns) const;
+
+  /// The initial guess and the motion during the scan, from the fusion (empty: LiDAR-only, or
+  /// before the filter is initialised).
+  [[nodiscard]] ScanPrior prior(const Scan& scan) const;
+  /// After the scan pipeline (frame.scan and frame.body_pose set): sets frame.drop_reason and,
+  /// unless dropped and when inertial, fuses the result at the current clock (frame.fused,
+  /// frame.available_ns = the fusion's time).
+  void link(const Scan& scan, OdometryFrame& frame);
+
+  [[nodiscard]] std::optional<fusion::FusionStats> stats() const;
+
+ private:
+  /// Steps the filter to the next output instant and appends its estimate.
+  void emit_step(Samples& out);
+
+  SE3 T_imu_lidar_;
+  std::optional<fusion::SensorFusion> fusion_;
+  std::vector<ImuSample> startup_imu_;  ///< the first kGravityAlignmentWindow_s, for the start pose
+  std::int64_t clock_ns_ = 0;
+  std::int64_t next_output_ns_ = 0;     ///< 0: set by the first IMU sample
+  std::optional<StampedPose> last_body_;  ///< the previous processed scan's body pose
+};
+
+}  // namespace farlio::pipeline
