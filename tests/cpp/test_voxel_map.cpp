@@ -189,6 +189,27 @@ TEST(VoxelMap, RemovesFarVoxelsOnly) {
   EXPECT_EQ(m.voxel_capacity(), cap_before);
 }
 
+TEST(VoxelMap, InsertRemoveCyclesKeepTheTableAtItsSize) {
+  // a drive: the map slides along x, far voxels leave and erased slots pile up; rehashing drops
+  // them in place, the table stays kSlotsPerVoxel x the pool (as on the GPU, whose table is fixed)
+  exec::CpuExecutor ex(2);
+  auto cfg = small_config();
+  cfg.removal_radius_m = 6.0;
+  cfg.initial_voxel_capacity = 1024;
+  VoxelMap m(cfg, ex);
+  const std::size_t table = m.table_capacity();
+  ASSERT_EQ(table, table_capacity_for(m.voxel_capacity()));
+  for (int step = 0; step < 200; ++step) {
+    const Eigen::Vector3f origin(0.5f * static_cast<float>(step), 0.0f, 0.0f);
+    auto pts = random_cloud(400, 5.0f, static_cast<unsigned>(step));
+    for (auto& p : pts) p += origin;
+    m.insert(pts, origin, PointLimit::constant(20));
+    m.remove_far(origin);
+    ASSERT_EQ(m.voxel_capacity(), 1024u) << "step " << step;
+    ASSERT_EQ(m.table_capacity(), table) << "step " << step;
+  }
+}
+
 TEST(VoxelMap, GrowthBeyondTheLimitIsAClearError) {
   exec::CpuExecutor ex(1);
   auto cfg = small_config();

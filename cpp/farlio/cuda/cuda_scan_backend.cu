@@ -121,7 +121,7 @@ class CudaScanBackend final : public pipeline::ScanBackend {
   registration::LinearSystem linear_system(const SE3& T, const registration::Thresholds& th,
                                            const RegistrationConfig& config) {
     const registration::FactorParams fp = registration::factor_params(T, th, config);
-    const map::MapView target = map_.view();
+    const map::ConstMapView target = map_.view();
     const Eigen::Vector4f* points = source_points_.data();
     const map::Cov3* covs = source_covs_.data();
     const registration::FactorSums sums = executor_.reduce(

@@ -2,6 +2,7 @@
 #include <cmath>
 #include <limits>
 
+#include "farlio/core/config_fields.hpp"
 #include "farlio/cuda/cuda_executor.cuh"
 #include "farlio/cuda/device_voxel_map.hpp"
 #include "farlio/map/voxel_update.hpp"
@@ -56,7 +57,7 @@ DeviceVoxelMap::DeviceVoxelMap(const VoxelMapConfig& config, std::size_t voxel_c
       points_(voxel_capacity * static_cast<std::size_t>(config.max_points_per_voxel), "map points"),
       covs_(voxel_capacity * static_cast<std::size_t>(config.max_points_per_voxel), "map points"),
       free_voxels_(voxel_capacity, "voxels") {
-  map::validate_map_config(config);
+  validate_config(config);
   if (voxel_capacity == 0 || voxel_capacity >= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max())) {
     throw CapacityError("CUDA backend: " + capacity_parameter_ + " must be in [1, 2^31)");
   }
@@ -69,25 +70,26 @@ void DeviceVoxelMap::reconfigure(const VoxelMapConfig& config) {
   if (config.max_points_per_voxel != config_.max_points_per_voxel) {
     throw std::invalid_argument("DeviceVoxelMap::reconfigure: max_points_per_voxel cannot change (buffers are preallocated)");
   }
-  map::validate_map_config(config);
+  validate_config(config);
   config_ = config;
   spacing_m_ = static_cast<float>(map::point_spacing_m(config));
   clear();
 }
 
-map::MapView DeviceVoxelMap::view() const {
-  map::MapView v;
-  v.slot_keys = slot_keys_.data();
-  v.slot_voxels = slot_voxels_.data();
-  v.table_capacity = slot_keys_.capacity();
-  v.voxel_keys = voxel_keys_.data();
-  v.voxel_counts = voxel_counts_.data();
-  v.points = points_.data();
-  v.covs = covs_.data();
-  v.max_points_per_voxel = config_.max_points_per_voxel;
-  v.voxel_size = static_cast<float>(config_.voxel_size_m);
-  v.inv_voxel_size = static_cast<float>(1.0 / config_.voxel_size_m);
-  return v;
+template <typename View, typename Self>
+View DeviceVoxelMap::view_of(Self& self) {
+  const VoxelMapConfig& c = self.config_;
+  return {self.slot_keys_.data(),  self.slot_voxels_.data(),  self.slot_keys_.capacity(),
+          self.voxel_keys_.data(), self.voxel_counts_.data(), self.points_.data(),
+          self.covs_.data(),       c.max_points_per_voxel,    static_cast<float>(c.voxel_size_m),
+          static_cast<float>(1.0 / c.voxel_size_m)};
+}
+
+map::MapView DeviceVoxelMap::view() { return view_of<map::MapView>(*this); }
+map::ConstMapView DeviceVoxelMap::view() const { return view_of<map::ConstMapView>(*this); }
+
+map::PoolCounts DeviceVoxelMap::counts() const {
+  return {high_water_, free_count_, live_voxels_, used_slots_, slot_keys_.capacity()};
 }
 
 void DeviceVoxelMap::clear() {
@@ -153,33 +155,24 @@ map::InsertStats DeviceVoxelMap::insert(const Eigen::Vector3f* points, std::size
   FARLIO_CUDA_CHECK(cudaMemsetAsync(s.scalars.data(), 0, s.scalars.bytes(), ex.stream()));
   std::int32_t* table_full = s.scalars.data() + kScalarTableFull;
   if (new_voxels > 0) {
-    const std::size_t from_pool = std::min(new_voxels, free_count_);
-    const std::size_t needed = high_water_ + (new_voxels - from_pool);
-    if (needed > capacity_) {
-      throw CapacityError("voxel map on the device is full: " + std::to_string(needed) + " voxels needed, " +
-                          capacity_parameter_ + " is " + std::to_string(capacity_) +
-                          "; raise it or lower map.removal_radius_m");
-    }
-    if (static_cast<double>(used_slots_ + new_voxels) > static_cast<double>(slot_keys_.capacity()) / map::kSlotsPerVoxel) {
+    const map::InsertionPlan plan = map::plan_insertion(counts(), new_voxels, capacity_, capacity_parameter_);
+    if (plan.rehash_slots > 0) {  // the device table has its one size: drop the erased slots in place
+      if (plan.rehash_slots != slot_keys_.capacity()) {
+        throw CapacityError("CUDA backend: the voxel table cannot grow; raise " + capacity_parameter_);
+      }
       rehash();
     }
-    // the CPU's allocation order: free voxels from the back of the list, then the high-water mark
+    // the host's allocation order (voxel_pool.hpp), one thread a group
     const std::int32_t* free_list = free_voxels_.data();
-    const auto pool = static_cast<std::int32_t>(from_pool);
-    const auto free_top = static_cast<std::int32_t>(free_count_);
-    const auto hw = static_cast<std::int32_t>(high_water_);
+    const std::size_t free_count = free_count_, from_free_list = plan.from_free_list, high_water = high_water_;
     ex.for_each(groups, [=] __device__(std::size_t g) {
       if (!missing[g]) return;
-      const std::int32_t r = rank[g];
-      const std::int32_t vox = r < pool ? free_list[free_top - 1 - r] : hw + (r - pool);
-      const std::uint64_t key = sorted_keys[group_start[g]];
-      v.voxel_keys[vox] = key;
-      v.voxel_counts[vox] = 0;
+      const std::int32_t vox = map::new_voxel_slot(rank[g], free_list, free_count, from_free_list, high_water);
       group_voxel[g] = vox;
-      if (map::table_insert(v, key, map::spatial_hash(map::unpack_key(key)), vox) < 0) exec::atomic_add(table_full, 1);
+      if (!map::add_voxel(v, sorted_keys[group_start[g]], vox)) exec::atomic_add(table_full, 1);
     });
-    free_count_ -= from_pool;
-    high_water_ = needed;
+    free_count_ -= plan.from_free_list;
+    high_water_ = plan.high_water;
     live_voxels_ += new_voxels;
     used_slots_ += new_voxels;
     stats.new_voxels = new_voxels;
@@ -203,8 +196,7 @@ map::InsertStats DeviceVoxelMap::insert(const Eigen::Vector3f* points, std::size
         t.inserted = gstats[g].inserted;
         t.spacing = gstats[g].spacing;
         t.full = gstats[g].full;
-        const std::int32_t count = v.voxel_counts[group_voxel[g]];
-        if (count != first_new[g]) t.covariances = count - (refresh ? 0 : first_new[g]);
+        t.covariances = map::covariance_points(v.voxel_counts[group_voxel[g]], first_new[g], refresh).size();
         if (g == 0) t.table_full = *table_full;
         return t;
       },
@@ -228,8 +220,8 @@ map::InsertStats DeviceVoxelMap::insert(const Eigen::Vector3f* points, std::size
       const std::size_t g = i / slots;
       const auto j = static_cast<std::int32_t>(i % slots);
       const std::int32_t vox = group_voxel[g];
-      const std::int32_t count = v.voxel_counts[vox];
-      if (count == first_new[g] || j < (refresh ? 0 : first_new[g]) || j >= count) return;
+      const map::PointRange r = map::covariance_points(v.voxel_counts[vox], first_new[g], refresh);
+      if (j < r.begin || j >= r.end) return;
       map::update_point_covariance(v, vox, j, k, eps, line_ratio);
     });
   }
@@ -237,7 +229,7 @@ map::InsertStats DeviceVoxelMap::insert(const Eigen::Vector3f* points, std::size
 }
 
 std::size_t DeviceVoxelMap::remove_far(const Eigen::Vector3f& origin) {
-  if (high_water_ == 0 || !std::isfinite(config_.removal_radius_m)) return 0;
+  if (!map::removal_applies(config_, high_water_)) return 0;
   const double r2 = config_.removal_radius_m * config_.removal_radius_m;
   const double vs = config_.voxel_size_m;
   const Eigen::Vector3d o = origin.cast<double>();
@@ -245,7 +237,7 @@ std::size_t DeviceVoxelMap::remove_far(const Eigen::Vector3f& origin) {
   std::uint8_t* flags = scratch_->flags.data();
   executor_->for_each(high_water_, [=] __device__(std::size_t i) {
     const std::uint64_t key = v.voxel_keys[i];
-    const bool far = key != map::kEmptyKey && map::voxel_centre_distance2(key, o, vs) > r2;
+    const bool far = map::voxel_is_far(key, o, r2, vs);
     flags[i] = far;
     if (!far) return;
     map::table_erase(v, key, map::spatial_hash(map::unpack_key(key)));
@@ -257,14 +249,12 @@ std::size_t DeviceVoxelMap::remove_far(const Eigen::Vector3f& origin) {
       algorithms_->select_flagged(scratch_->iota.data(), flags, free_voxels_.data() + free_count_, high_water_);
   free_count_ += removed;
   live_voxels_ -= removed;
-  if (static_cast<double>(used_slots_ - live_voxels_) > map::kMaxErasedFraction * static_cast<double>(slot_keys_.capacity())) {
-    rehash();
-  }
+  if (map::rehash_after_removal(counts())) rehash();
   return removed;
 }
 
 double DeviceVoxelMap::mean_points_per_voxel(const Eigen::Vector3f& origin, double range_m) const {
-  const map::MapView v = view();
+  const map::ConstMapView v = view();
   const double vs = config_.voxel_size_m;
   const Eigen::Vector3d o = origin.cast<double>();
   const VoxelTotals t = executor_->reduce(
@@ -290,7 +280,7 @@ std::size_t DeviceVoxelMap::num_points() const {
 std::size_t DeviceVoxelMap::gather(Eigen::Vector4f* out_points, map::Cov3* out_covs, std::size_t capacity,
                                    const char* parameter) {
   if (high_water_ == 0) return 0;
-  const map::MapView v = view();
+  const map::ConstMapView v = view();
   std::int32_t* counts = scratch_->missing.data();
   std::int32_t* offsets = scratch_->rank.data();
   const std::size_t hw = high_water_;
@@ -348,7 +338,7 @@ KnnResults DeviceVoxelMap::knn(const std::vector<Eigen::Vector3f>& queries, int 
   DeviceBuffer<float> d2(nq * per, "queries");
   const cudaStream_t st = executor_->stream();
   q.upload(queries.data(), nq, st, "(queries)");
-  const map::MapView v = view();
+  const map::ConstMapView v = view();
   const Eigen::Vector3f* qp = q.data();
   int* fp = found.data();
   std::int64_t* ip = idx.data();

@@ -20,6 +20,7 @@
 #include "farlio/map/map_view.hpp"
 #include "farlio/map/point_limit.hpp"
 #include "farlio/map/voxel_map.hpp"
+#include "farlio/map/voxel_pool.hpp"
 
 namespace farlio::cuda {
 
@@ -53,7 +54,9 @@ class DeviceVoxelMap {
   /// Rebuilds the table from the live voxels (drops erased markers).
   void rehash();
 
-  [[nodiscard]] map::MapView view() const;
+  /// The kernels' window on the map: mutable for updates, read-only for searches.
+  [[nodiscard]] map::MapView view();
+  [[nodiscard]] map::ConstMapView view() const;
   [[nodiscard]] float spacing_m() const { return spacing_m_; }
   [[nodiscard]] std::size_t num_voxels() const { return live_voxels_; }
   [[nodiscard]] std::size_t num_points() const;
@@ -65,6 +68,10 @@ class DeviceVoxelMap {
   [[nodiscard]] KnnResults knn(const std::vector<Eigen::Vector3f>& queries, int k, float max_distance2) const;
 
  private:
+  template <typename View, typename Self>
+  static View view_of(Self& self);
+  [[nodiscard]] map::PoolCounts counts() const;
+
   VoxelMapConfig config_;
   std::size_t capacity_;
   std::string capacity_parameter_;

@@ -33,7 +33,7 @@ double median_ms(CudaExecutor& ex, int repeats, const Launch& launch) {
 
 /// Bytes a search around p within bound2 asks for: probed slots (key + voxel), then each
 /// visited voxel's count and points.
-FARLIO_HD double neighbourhood_bytes(const map::MapView& m, const Eigen::Vector3f& p, float bound2) {
+FARLIO_HD double neighbourhood_bytes(const map::ConstMapView& m, const Eigen::Vector3f& p, float bound2) {
   constexpr double kSlotBytes = sizeof(std::uint64_t) + sizeof(std::int32_t);
   constexpr double kPointBytes = sizeof(Eigen::Vector4f);
   double bytes = 0.0;
@@ -44,7 +44,7 @@ FARLIO_HD double neighbourhood_bytes(const map::MapView& m, const Eigen::Vector3
 }
 
 /// Bytes asked for by searches around R * points[i] + t within bound2, the queries included.
-double search_bytes(CudaExecutor& ex, const map::MapView& m, const Eigen::Vector4f* points, std::size_t n, float bound2,
+double search_bytes(CudaExecutor& ex, const map::ConstMapView& m, const Eigen::Vector4f* points, std::size_t n, float bound2,
                     const Eigen::Matrix3f& R, const Eigen::Vector3f& t) {
   return ex.reduce(
       n, 0.0,
@@ -60,7 +60,7 @@ void copy_kernel(CudaExecutor& ex, const float4* src, float4* dst, std::size_t n
   ex.for_each(n, [=] __device__(std::size_t i) { dst[i] = src[i]; });
 }
 
-void knn_kernel(CudaExecutor& ex, const map::MapView& m, const Eigen::Vector4f* points, std::size_t n, int k,
+void knn_kernel(CudaExecutor& ex, const map::ConstMapView& m, const Eigen::Vector4f* points, std::size_t n, int k,
                 float max_distance2, int* found, std::int64_t* indices, float* distances2) {
   const auto per = static_cast<std::size_t>(k);
   ex.for_each(n, [=] __device__(std::size_t i) {
@@ -68,7 +68,7 @@ void knn_kernel(CudaExecutor& ex, const map::MapView& m, const Eigen::Vector4f* 
   });
 }
 
-void reduction_kernel(CudaExecutor& ex, const map::MapView& m, const Eigen::Vector4f* points, const map::Cov3* covs,
+void reduction_kernel(CudaExecutor& ex, const map::ConstMapView& m, const Eigen::Vector4f* points, const map::Cov3* covs,
                       std::size_t n, const registration::FactorParams& fp) {
   ex.reduce(
       n, registration::FactorSums::zero(),
@@ -89,7 +89,7 @@ BandwidthSample measure_copy(CudaExecutor& ex, std::size_t bytes, int repeats) {
   return s;
 }
 
-BandwidthSample measure_knn(CudaExecutor& ex, const map::MapView& m, const Eigen::Vector4f* points, std::size_t n, int k,
+BandwidthSample measure_knn(CudaExecutor& ex, const map::ConstMapView& m, const Eigen::Vector4f* points, std::size_t n, int k,
                             float max_distance2, int repeats) {
   DeviceBuffer<std::int64_t> idx(n * static_cast<std::size_t>(k), "k-NN results");
   DeviceBuffer<float> d2(n * static_cast<std::size_t>(k), "k-NN results");
@@ -104,7 +104,7 @@ BandwidthSample measure_knn(CudaExecutor& ex, const map::MapView& m, const Eigen
   return s;
 }
 
-BandwidthSample measure_gicp_reduction(CudaExecutor& ex, const map::MapView& m, const Eigen::Vector4f* points,
+BandwidthSample measure_gicp_reduction(CudaExecutor& ex, const map::ConstMapView& m, const Eigen::Vector4f* points,
                                        const map::Cov3* covs, std::size_t n, float max_distance2, const SE3& pose,
                                        int repeats) {
   registration::FactorParams fp = registration::factor_params(pose, registration::Thresholds::from_sigma(1.0), RegistrationConfig{});

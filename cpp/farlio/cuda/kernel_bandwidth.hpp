@@ -26,12 +26,12 @@ struct BandwidthSample {
 BandwidthSample measure_copy(CudaExecutor& executor, std::size_t bytes, int repeats);
 
 /// k-NN of n device points in `target` (k neighbours within sqrt(max_distance2)).
-BandwidthSample measure_knn(CudaExecutor& executor, const map::MapView& target, const Eigen::Vector4f* points,
+BandwidthSample measure_knn(CudaExecutor& executor, const map::ConstMapView& target, const Eigen::Vector4f* points,
                             std::size_t n, int k, float max_distance2, int repeats);
 
 /// One GICP linear system of n device source points against `target` at `pose` with
 /// correspondences within sqrt(max_distance2).
-BandwidthSample measure_gicp_reduction(CudaExecutor& executor, const map::MapView& target, const Eigen::Vector4f* points,
+BandwidthSample measure_gicp_reduction(CudaExecutor& executor, const map::ConstMapView& target, const Eigen::Vector4f* points,
                                        const map::Cov3* covs, std::size_t n, float max_distance2, const SE3& pose,
                                        int repeats);
 

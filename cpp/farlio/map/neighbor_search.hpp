@@ -29,7 +29,7 @@ FARLIO_HD inline float voxel_box_distance2(const Eigen::Vector3f& p, const Voxel
 /// Calls visit(voxel_index) for each of the 27 voxels around p (centre first) that exists and
 /// whose box is closer than bound2() (re-read before each voxel, so it may shrink).
 template <typename Visit, typename Bound>
-FARLIO_HD void for_each_nearby_voxel(const MapView& m, const Eigen::Vector3f& p, const Bound& bound2,
+FARLIO_HD void for_each_nearby_voxel(const ConstMapView& m, const Eigen::Vector3f& p, const Bound& bound2,
                                      const Visit& visit) {
   const VoxelCoord c0 = voxel_of(p, m.inv_voxel_size);
   for (int n = 0; n < 27; ++n) {
@@ -43,7 +43,7 @@ FARLIO_HD void for_each_nearby_voxel(const MapView& m, const Eigen::Vector3f& p,
 }
 
 /// Index (into m.points) of the point nearest to p within sqrt(max_distance2), or -1.
-FARLIO_HD inline std::int64_t nearest_neighbor(const MapView& m, const Eigen::Vector3f& p, float max_distance2,
+FARLIO_HD inline std::int64_t nearest_neighbor(const ConstMapView& m, const Eigen::Vector3f& p, float max_distance2,
                                                float* distance2 = nullptr) {
   float best = max_distance2;
   std::int64_t best_index = -1;
@@ -64,7 +64,7 @@ FARLIO_HD inline std::int64_t nearest_neighbor(const MapView& m, const Eigen::Ve
 
 /// The k nearest points to p (k <= kMaxNeighbors) within sqrt(max_distance2), sorted by
 /// distance. Returns how many were found (< k when the neighbourhood holds fewer).
-FARLIO_HD inline int knn_search(const MapView& m, const Eigen::Vector3f& p, int k, float max_distance2,
+FARLIO_HD inline int knn_search(const ConstMapView& m, const Eigen::Vector3f& p, int k, float max_distance2,
                                 std::int64_t* indices, float* distances2) {
   int found = 0;
   auto bound = [&] { return found < k ? max_distance2 : distances2[k - 1]; };

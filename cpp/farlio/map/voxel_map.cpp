@@ -8,12 +8,13 @@
 #include <limits>
 #include <string>
 
+#include "farlio/core/config_fields.hpp"
 #include "farlio/core/error.hpp"
 #include "farlio/map/voxel_update.hpp"
 
 namespace farlio::map {
 namespace {
-std::size_t next_pow2(std::size_t n) { return std::bit_ceil(std::max<std::size_t>(n, 16)); }
+constexpr const char* kCapacityParameter = "map.max_voxel_capacity";
 }  // namespace
 
 double point_spacing_m(const VoxelMapConfig& config) {
@@ -21,56 +22,38 @@ double point_spacing_m(const VoxelMapConfig& config) {
                                       : config.voxel_size_m / std::sqrt(static_cast<double>(config.max_points_per_voxel));
 }
 
-std::size_t table_capacity_for(std::size_t voxel_capacity) { return next_pow2(kSlotsPerVoxel * voxel_capacity); }
-
-void validate_map_config(const VoxelMapConfig& config) {
-  if (config.voxel_size_m <= 0 || config.max_points_per_voxel <= 0 || config.covariance_neighbors <= 0 ||
-      config.covariance_neighbors > kMaxNeighbors) {
-    throw std::invalid_argument("VoxelMap: voxel_size_m and max_points_per_voxel must be > 0 and "
-                                "covariance_neighbors in [1, " + std::to_string(kMaxNeighbors) + "]");
-  }
-}
-
 VoxelMap::VoxelMap(const VoxelMapConfig& config, exec::CpuExecutor& executor)
-    : config_(config),
-      executor_(&executor),
-      spacing_m_(static_cast<float>(point_spacing_m(config))) {
-  validate_map_config(config);
-  reserve_voxels(static_cast<std::size_t>(std::max<std::int64_t>(config.initial_voxel_capacity, 1)));
+    : config_(config), executor_(&executor), spacing_m_(static_cast<float>(point_spacing_m(config))) {
+  validate_config(config);
+  reserve_voxels(static_cast<std::size_t>(config.initial_voxel_capacity));
+  rehash(table_capacity_for(voxel_capacity()));
 }
 
-MapView VoxelMap::view() const {
-  auto* self = const_cast<VoxelMap*>(this);  // the view is the kernels' mutable window
-  MapView v;
-  v.slot_keys = self->slot_keys_.data();
-  v.slot_voxels = self->slot_voxels_.data();
-  v.table_capacity = slot_keys_.size();
-  v.voxel_keys = self->voxel_keys_.data();
-  v.voxel_counts = self->voxel_counts_.data();
-  v.points = self->points_.data();
-  v.covs = self->covs_.data();
-  v.max_points_per_voxel = config_.max_points_per_voxel;
-  v.voxel_size = static_cast<float>(config_.voxel_size_m);
-  v.inv_voxel_size = static_cast<float>(1.0 / config_.voxel_size_m);
-  return v;
+template <typename View, typename Self>
+View VoxelMap::view_of(Self& self) {
+  const VoxelMapConfig& c = self.config_;
+  return {self.slot_keys_.data(),  self.slot_voxels_.data(),  self.slot_keys_.size(),
+          self.voxel_keys_.data(), self.voxel_counts_.data(), self.points_.data(),
+          self.covs_.data(),       c.max_points_per_voxel,    static_cast<float>(c.voxel_size_m),
+          static_cast<float>(1.0 / c.voxel_size_m)};
+}
+
+MapView VoxelMap::view() { return view_of<MapView>(*this); }
+ConstMapView VoxelMap::view() const { return view_of<ConstMapView>(*this); }
+
+PoolCounts VoxelMap::counts() const {
+  return {high_water_, free_voxels_.size(), live_voxels_, used_slots_, slot_keys_.size()};
 }
 
 void VoxelMap::reserve_voxels(std::size_t needed) {
-  const std::size_t cap = voxel_keys_.size();
-  if (needed > cap) {
-    const auto max_cap = static_cast<std::size_t>(config_.max_voxel_capacity);
-    if (needed > max_cap) {
-      throw CapacityError("voxel map is full: " + std::to_string(needed) + " voxels needed, map.max_voxel_capacity is " +
-                          std::to_string(max_cap) + "; raise it or lower map.removal_radius_m");
-    }
-    const std::size_t new_cap = std::min(max_cap, std::max(needed, 2 * cap));
-    const auto n = static_cast<std::size_t>(config_.max_points_per_voxel);
-    voxel_keys_.resize(new_cap, kEmptyKey);
-    voxel_counts_.resize(new_cap, 0);
-    points_.resize(new_cap * n, Eigen::Vector4f::Zero());
-    covs_.resize(new_cap * n);
-  }
-  if (slot_keys_.size() < kSlotsPerVoxel * voxel_keys_.size()) rehash(table_capacity_for(voxel_keys_.size()));
+  const std::size_t cap = grown_pool_capacity(needed, voxel_keys_.size(),
+                                              static_cast<std::size_t>(config_.max_voxel_capacity), kCapacityParameter);
+  if (cap == voxel_keys_.size()) return;
+  const auto n = static_cast<std::size_t>(config_.max_points_per_voxel);
+  voxel_keys_.resize(cap, kEmptyKey);
+  voxel_counts_.resize(cap, 0);
+  points_.resize(cap * n, Eigen::Vector4f::Zero());
+  covs_.resize(cap * n);
 }
 
 void VoxelMap::rehash(std::size_t slots) {
@@ -86,20 +69,6 @@ void VoxelMap::rehash(std::size_t slots) {
 }
 
 void VoxelMap::set_table_capacity_for_testing(std::size_t slots) { rehash(std::bit_ceil(slots)); }
-
-std::int32_t VoxelMap::allocate_voxel(std::uint64_t key) {
-  std::int32_t v;
-  if (!free_voxels_.empty()) {
-    v = free_voxels_.back();
-    free_voxels_.pop_back();
-  } else {
-    v = static_cast<std::int32_t>(high_water_++);
-  }
-  voxel_keys_[static_cast<std::size_t>(v)] = key;
-  voxel_counts_[static_cast<std::size_t>(v)] = 0;
-  ++live_voxels_;
-  return v;
-}
 
 InsertStats VoxelMap::insert(const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& origin,
                              const PointLimit& limit) {
@@ -124,10 +93,10 @@ InsertStats VoxelMap::insert(const std::vector<Eigen::Vector3f>& points, const E
   const std::size_t groups = group_start.size();
   group_start.push_back(keyed.size());
 
-  // 2. find existing voxels, create the missing ones (serially: deterministic pool indices)
+  // 2. find existing voxels, create the missing ones (serially, in key order: voxel_pool.hpp)
   std::vector<std::int32_t> group_voxel(groups);
   {
-    const MapView v = view();
+    const ConstMapView v = view();
     executor_->for_each(groups, [&](std::size_t g) {
       const std::uint64_t key = keyed[group_start[g]].first;
       group_voxel[g] = table_find(v, key, spatial_hash(unpack_key(key)));
@@ -135,21 +104,25 @@ InsertStats VoxelMap::insert(const std::vector<Eigen::Vector3f>& points, const E
   }
   const auto missing = static_cast<std::size_t>(std::count(group_voxel.begin(), group_voxel.end(), -1));
   if (missing > 0) {
-    const std::size_t from_pool = std::min(missing, free_voxels_.size());
-    reserve_voxels(high_water_ + (missing - from_pool));
-    if (static_cast<double>(used_slots_ + missing) > static_cast<double>(slot_keys_.size()) / kSlotsPerVoxel) {
-      rehash(next_pow2(2 * slot_keys_.size()));
-    }
+    reserve_voxels(voxels_needed(counts(), missing));
+    const InsertionPlan plan = plan_insertion(counts(), missing, voxel_capacity(), kCapacityParameter);
+    if (plan.rehash_slots > 0) rehash(plan.rehash_slots);
     const MapView v = view();
+    std::int32_t rank = 0;
     for (std::size_t g = 0; g < groups; ++g) {
       if (group_voxel[g] >= 0) continue;
       const std::uint64_t key = keyed[group_start[g]].first;
-      group_voxel[g] = allocate_voxel(key);
-      if (table_insert(v, key, spatial_hash(unpack_key(key)), group_voxel[g]) < 0) {
+      const std::int32_t vox =
+          new_voxel_slot(rank++, free_voxels_.data(), free_voxels_.size(), plan.from_free_list, high_water_);
+      group_voxel[g] = vox;
+      if (!add_voxel(v, key, vox)) {
         throw CapacityError("voxel map hash table is full (" + std::to_string(slot_keys_.size()) + " slots)");
       }
-      ++used_slots_;
     }
+    free_voxels_.resize(free_voxels_.size() - plan.from_free_list);
+    high_water_ = plan.high_water;
+    live_voxels_ += missing;
+    used_slots_ += missing;
     stats.new_voxels = missing;
   }
 
@@ -171,37 +144,35 @@ InsertStats VoxelMap::insert(const std::vector<Eigen::Vector3f>& points, const E
     stats.rejected_full += static_cast<std::size_t>(s.full);
   }
 
-  // 4. covariances of the new points (or of every point of a changed voxel)
-  std::vector<std::int32_t> cov_voxels, cov_first;
+  // 4. covariances of the new points (or of every point of a changed voxel), one task a voxel
+  std::vector<std::int32_t> cov_voxels;
+  std::vector<PointRange> cov_points;
   for (std::size_t g = 0; g < groups; ++g) {
-    const std::int32_t count = voxel_counts_[static_cast<std::size_t>(group_voxel[g])];
-    if (count == first_new[g]) continue;
+    const PointRange r =
+        covariance_points(voxel_counts_[static_cast<std::size_t>(group_voxel[g])], first_new[g], config_.refresh_covariances);
+    if (r.size() == 0) continue;
     cov_voxels.push_back(group_voxel[g]);
-    cov_first.push_back(config_.refresh_covariances ? 0 : first_new[g]);
-    stats.covariances_computed += static_cast<std::size_t>(count - cov_first.back());
+    cov_points.push_back(r);
+    stats.covariances_computed += static_cast<std::size_t>(r.size());
   }
-  compute_covariances(cov_voxels, cov_first);
-  return stats;
-}
-
-void VoxelMap::compute_covariances(const std::vector<std::int32_t>& voxels, const std::vector<std::int32_t>& first_point) {
   const MapView v = view();
   const int k = config_.covariance_neighbors;
   const auto eps = static_cast<float>(config_.covariance_epsilon);
   const auto line_ratio = static_cast<float>(config_.line_eigenvalue_ratio);
-  executor_->for_each(voxels.size(),
-                      [&](std::size_t i) { update_voxel_covariances(v, voxels[i], first_point[i], k, eps, line_ratio); });
+  executor_->for_each(cov_voxels.size(), [&](std::size_t i) {
+    update_voxel_covariances(v, cov_voxels[i], cov_points[i], k, eps, line_ratio);
+  });
+  return stats;
 }
 
 std::size_t VoxelMap::remove_far(const Eigen::Vector3f& origin) {
+  if (!removal_applies(config_, high_water_)) return 0;
   const double r2 = config_.removal_radius_m * config_.removal_radius_m;
-  const double vs = config_.voxel_size_m;
   const MapView v = view();
   std::size_t removed = 0;
   for (std::size_t i = 0; i < high_water_; ++i) {
     const std::uint64_t key = voxel_keys_[i];
-    if (key == kEmptyKey) continue;
-    if (voxel_centre_distance2(key, origin.cast<double>(), vs) <= r2) continue;
+    if (!voxel_is_far(key, origin.cast<double>(), r2, config_.voxel_size_m)) continue;
     table_erase(v, key, spatial_hash(unpack_key(key)));
     voxel_keys_[i] = kEmptyKey;
     voxel_counts_[i] = 0;
@@ -209,9 +180,7 @@ std::size_t VoxelMap::remove_far(const Eigen::Vector3f& origin) {
     --live_voxels_;
     ++removed;
   }
-  if (static_cast<double>(used_slots_ - live_voxels_) > kMaxErasedFraction * static_cast<double>(slot_keys_.size())) {
-    rehash(slot_keys_.size());
-  }
+  if (rehash_after_removal(counts())) rehash(slot_keys_.size());
   return removed;
 }
 

@@ -1,8 +1,9 @@
 #pragma once
-// VoxelMap: the host owner of a voxel hash map (cuVoxelMap's layout, see map_view.hpp) and its
-// updates on the CPU executor: insertion with a per-voxel cap and a minimum spacing,
-// covariances from the k nearest neighbours (eq. 1), removal of far voxels, and a growth
-// policy with a hard limit (CapacityError beyond map.max_voxel_capacity).
+// VoxelMap: the host owner of a voxel hash map (the layout of map_view.hpp) and its updates on
+// the CPU executor: insertion with a per-voxel cap and a minimum spacing, covariances from the k
+// nearest neighbours (eq. 1), removal of far voxels, and a pool that grows up to a hard limit
+// (CapacityError beyond map.max_voxel_capacity). The decisions of an update (growth, rehash,
+// new voxel slots, removal) are voxel_pool.hpp's, shared with the CUDA backend's DeviceVoxelMap.
 //
 // Updates are deterministic: points are grouped by voxel (sorted by key, then by input order)
 // and each voxel's candidates are processed in that order by one task, so the map's contents do
@@ -17,19 +18,9 @@
 #include "farlio/map/map_snapshot.hpp"
 #include "farlio/map/map_view.hpp"
 #include "farlio/map/point_limit.hpp"
+#include "farlio/map/voxel_pool.hpp"
 
 namespace farlio::map {
-
-/// The table keeps at least this many slots per voxel of pool capacity (load factor <= 0.5).
-inline constexpr std::size_t kSlotsPerVoxel = 2;
-/// Rehash (in place) when erased markers exceed this fraction of the table.
-inline constexpr double kMaxErasedFraction = 0.25;
-
-/// Slots of the table for a pool of `voxel_capacity` voxels (a power of two).
-std::size_t table_capacity_for(std::size_t voxel_capacity);
-
-/// Throws std::invalid_argument when the sizes of `config` cannot make a map.
-void validate_map_config(const VoxelMapConfig& config);
 
 /// The minimum distance between points of a voxel: config.point_spacing_m, or
 /// voxel_size_m / sqrt(max_points_per_voxel) when that is 0.
@@ -59,7 +50,9 @@ class VoxelMap {
   /// Removes everything (keeps the allocation).
   void clear();
 
-  [[nodiscard]] MapView view() const;
+  /// The kernels' window on the map: mutable for updates, read-only for searches.
+  [[nodiscard]] MapView view();
+  [[nodiscard]] ConstMapView view() const;
   [[nodiscard]] const VoxelMapConfig& config() const { return config_; }
   /// Minimum distance between two points of a voxel (config.point_spacing_m or
   /// voxel_size / sqrt(max_points_per_voxel)).
@@ -82,10 +75,12 @@ class VoxelMap {
   void set_table_capacity_for_testing(std::size_t slots);
 
  private:
+  template <typename View, typename Self>
+  static View view_of(Self& self);
+  [[nodiscard]] PoolCounts counts() const;
+  /// Grows the pool to hold `needed` voxels (doubling, up to map.max_voxel_capacity).
   void reserve_voxels(std::size_t needed);
   void rehash(std::size_t slots);
-  std::int32_t allocate_voxel(std::uint64_t key);
-  void compute_covariances(const std::vector<std::int32_t>& voxels, const std::vector<std::int32_t>& first_point);
 
   VoxelMapConfig config_;
   exec::CpuExecutor* executor_;  // not owned (a pointer keeps the map movable)

@@ -27,6 +27,14 @@ FARLIO_HD inline std::uint64_t point_key(const Eigen::Vector3f& p, float inv_cel
   return in_key_range(c) ? pack_key(c) : kEmptyKey;
 }
 
+/// Stores the new voxel `key` in the free pool slot `voxel` (empty) and in the table; false when
+/// the table is full.
+FARLIO_HD inline bool add_voxel(const MapView& m, std::uint64_t key, std::int32_t voxel) {
+  m.voxel_keys[voxel] = key;
+  m.voxel_counts[voxel] = 0;
+  return table_insert(m, key, spatial_hash(unpack_key(key)), voxel) >= 0;
+}
+
 /// What happened to one voxel's candidates.
 struct GroupStats {
   std::int32_t inserted = 0, spacing = 0, full = 0;
@@ -71,6 +79,17 @@ FARLIO_HD GroupStats insert_voxel_group(const MapView& m, std::int32_t voxel, co
   return s;
 }
 
+/// The points [begin, end) of a voxel whose covariances an insertion (re)computes: none when it
+/// received no point (count == first_new), else the new ones, or all when `refresh`.
+struct PointRange {
+  std::int32_t begin = 0, end = 0;
+  [[nodiscard]] FARLIO_HD std::int32_t size() const { return end - begin; }
+};
+FARLIO_HD inline PointRange covariance_points(std::int32_t count, std::int32_t first_new, bool refresh) {
+  if (count == first_new) return {};
+  return {refresh ? 0 : first_new, count};
+}
+
 /// No distance limit for the covariance neighbours (the 27 voxels bound them).
 inline constexpr float kUnboundedDistance2 = std::numeric_limits<float>::max();
 
@@ -95,11 +114,10 @@ FARLIO_HD inline void update_point_covariance(const MapView& m, std::int32_t vox
   m.points[pi].w() = shape_code(classify_shape(cov, line_ratio));
 }
 
-/// Covariances of the points [first, count) of `voxel` (one CPU task a voxel).
-FARLIO_HD inline void update_voxel_covariances(const MapView& m, std::int32_t voxel, std::int32_t first, int k,
+/// Covariances of the points `points` of `voxel` (one CPU task a voxel).
+FARLIO_HD inline void update_voxel_covariances(const MapView& m, std::int32_t voxel, const PointRange& points, int k,
                                                float epsilon, float line_ratio) {
-  const std::int32_t count = m.voxel_counts[voxel];
-  for (std::int32_t j = first; j < count; ++j) update_point_covariance(m, voxel, j, k, epsilon, line_ratio);
+  for (std::int32_t j = points.begin; j < points.end; ++j) update_point_covariance(m, voxel, j, k, epsilon, line_ratio);
 }
 
 /// Squared distance (double) from `origin` to the centre of the voxel with this key.
@@ -107,6 +125,12 @@ FARLIO_HD inline double voxel_centre_distance2(std::uint64_t key, const Eigen::V
   const VoxelCoord c = unpack_key(key);
   const Eigen::Vector3d centre = (c.cast<double>() + Eigen::Vector3d::Constant(0.5)) * voxel_size;
   return (centre - origin).squaredNorm();
+}
+
+/// Whether remove_far removes the voxel of this pool entry: a live voxel whose centre is farther
+/// than sqrt(radius2) from origin.
+FARLIO_HD inline bool voxel_is_far(std::uint64_t key, const Eigen::Vector3d& origin, double radius2, double voxel_size) {
+  return key != kEmptyKey && voxel_centre_distance2(key, origin, voxel_size) > radius2;
 }
 
 }  // namespace farlio::map

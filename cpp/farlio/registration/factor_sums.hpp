@@ -37,7 +37,7 @@ struct AddFactorSums {
 };
 
 /// The factor of source point i as sums (zero when it has no correspondence).
-FARLIO_HD inline FactorSums factor_sums(const map::MapView& target, const Eigen::Vector4f& point,
+FARLIO_HD inline FactorSums factor_sums(const map::ConstMapView& target, const Eigen::Vector4f& point,
                                         const map::Cov3& cov, const FactorParams& fp) {
   FactorSums a = FactorSums::zero();
   FactorTerms f;

@@ -15,7 +15,7 @@ double point_to_point_precision(const RegistrationConfig& config, double covaria
   return sigma2 > 0.0 ? covariance_epsilon / sigma2 : 1.0;
 }
 
-SourceCloud source_from_map(const map::MapView& m, std::size_t voxel_capacity) {
+SourceCloud source_from_map(const map::ConstMapView& m, std::size_t voxel_capacity) {
   SourceCloud src;
   for (std::size_t v = 0; v < voxel_capacity; ++v) {
     const auto vox = static_cast<std::int32_t>(v);
@@ -39,7 +39,7 @@ FactorParams factor_params(const SE3& T, const Thresholds& th, const Registratio
   return fp;
 }
 
-LinearSystem build_linear_system(const SourceCloud& source, const map::MapView& target, const SE3& T,
+LinearSystem build_linear_system(const SourceCloud& source, const map::ConstMapView& target, const SE3& T,
                                  const Thresholds& th, const RegistrationConfig& config,
                                  exec::CpuExecutor& executor) {
   const FactorParams fp = factor_params(T, th, config);
@@ -49,7 +49,7 @@ LinearSystem build_linear_system(const SourceCloud& source, const map::MapView& 
   return to_linear_system(sum);
 }
 
-RegistrationResult register_scan(const SourceCloud& source, const map::MapView& target, const SE3& initial_guess,
+RegistrationResult register_scan(const SourceCloud& source, const map::ConstMapView& target, const SE3& initial_guess,
                                  const Thresholds& th, const RegistrationConfig& config, double time_budget_s,
                                  exec::CpuExecutor& executor) {
   return gauss_newton(

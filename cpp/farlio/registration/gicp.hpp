@@ -32,7 +32,7 @@ struct RegistrationResult {
 };
 
 /// The stored points of a map with their covariances (the per-scan frame map gives the source).
-SourceCloud source_from_map(const map::MapView& frame_map, std::size_t voxel_capacity);
+SourceCloud source_from_map(const map::ConstMapView& frame_map, std::size_t voxel_capacity);
 
 /// Correspondence distance (3 sigma) and kernel scale (sigma / 3), as in KISS-ICP, and the
 /// weight of point-to-point factors.
@@ -55,11 +55,11 @@ FactorParams factor_params(const SE3& T, const Thresholds& th, const Registratio
 double point_to_point_precision(const RegistrationConfig& config, double covariance_epsilon, double spacing_m);
 
 /// The linear system of `source` at pose T against the map.
-LinearSystem build_linear_system(const SourceCloud& source, const map::MapView& target, const SE3& T,
+LinearSystem build_linear_system(const SourceCloud& source, const map::ConstMapView& target, const SE3& T,
                                  const Thresholds& th, const RegistrationConfig& config,
                                  exec::CpuExecutor& executor);
 
-RegistrationResult register_scan(const SourceCloud& source, const map::MapView& target, const SE3& initial_guess,
+RegistrationResult register_scan(const SourceCloud& source, const map::ConstMapView& target, const SE3& initial_guess,
                                  const Thresholds& th, const RegistrationConfig& config, double time_budget_s,
                                  exec::CpuExecutor& executor);
 

@@ -40,7 +40,7 @@ struct FactorParams {
 
 /// Computes the factor of source point `s` (w = 1 if `cov_s` is valid). Returns false (and
 /// leaves `out` untouched) when there is no correspondence within the distance.
-FARLIO_HD inline bool gicp_factor(const map::MapView& m, const Eigen::Vector4f& s, const map::Cov3& cov_s,
+FARLIO_HD inline bool gicp_factor(const map::ConstMapView& m, const Eigen::Vector4f& s, const map::Cov3& cov_s,
                                   const FactorParams& fp, FactorTerms& out) {
   const Eigen::Vector3f sp = s.head<3>();
   const Eigen::Vector3f p = fp.R * sp + fp.t;
