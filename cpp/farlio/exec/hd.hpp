@@ -4,7 +4,6 @@
 // CUDA launch (cpp/farlio/cuda/).
 #if defined(__CUDACC__)
 #define FARLIO_HD __host__ __device__
-#define FARLIO_DEVICE_CODE 1
 #else
 #define FARLIO_HD
 #endif
