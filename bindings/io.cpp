@@ -1,5 +1,6 @@
 // Bindings of farlio::io: point cloud files, trajectory files and the sequence folder.
 // Paths are str or os.PathLike; bad input raises farlio._core.InputError (a ValueError).
+#include <nanobind/eigen/dense.h>
 #include <nanobind/stl/filesystem.h>
 #include <nanobind/stl/map.h>
 #include <nanobind/stl/optional.h>
@@ -9,6 +10,7 @@
 #include "bindings.hpp"
 #include "farlio/io/calibration.hpp"
 #include "farlio/io/point_cloud_io.hpp"
+#include "farlio/io/rigid_transform.hpp"
 #include "farlio/io/sequence.hpp"
 #include "farlio/io/trajectory_io.hpp"
 
@@ -62,14 +64,24 @@ void bind_trajectories(nb::module_& m) {
 }
 
 void bind_sequence(nb::module_& m) {
-  nb::class_<Calibration>(m, "Calibration", "calib.yaml: extrinsic, gravity, sensor rates.")
+  nb::class_<Calibration>(m, "Calibration", "calib.yaml: extrinsic(s), gravity, sensor rates.")
       .def(nb::init<>())
-      .def_rw("T_imu_lidar", &Calibration::T_imu_lidar)
-      .def_rw("gravity_m_s2", &Calibration::gravity_m_s2)
+      .def_rw("T_imu_lidar", &Calibration::T_imu_lidar, "one LiDAR: maps its points into the IMU (body) frame")
+      .def_rw("T_imu_lidar_by_name", &Calibration::T_imu_lidar_by_name,
+              "several LiDARs: {topic or frame id: T_imu_lidar} (a copy); empty for one LiDAR")
+      .def_rw("gravity_m_s2", &Calibration::gravity_m_s2, "None when the file does not state it")
       .def_rw("imu_rate_hz", &Calibration::imu_rate_hz)
-      .def_rw("lidar_rate_hz", &Calibration::lidar_rate_hz);
+      .def_rw("lidar_rate_hz", &Calibration::lidar_rate_hz)
+      .def_rw("source", &Calibration::source, "the file it was read from")
+      .def("gravity_or_default", &Calibration::gravity_or_default, "gravity_m_s2, or 9.81 when not stated")
+      .def("lidar_extrinsic", &Calibration::lidar_extrinsic, "names"_a,
+           "T_imu_lidar of the LiDAR known by any of names (topic, frame id); InputError naming the entries "
+           "when the mapping has none of them.");
   m.def("read_calibration", &read_calibration, "path"_a);
   m.def("write_calibration", &write_calibration, "path"_a, "calibration"_a);
+  m.def("rigid_transform_from_matrix", &rigid_transform_from_matrix, "m"_a, "what"_a,
+        "The SE3 of a 4x4 matrix if it is rigid (finite, rotation orthonormal, last row 0 0 0 1, within the "
+        "tolerance of calib.yaml); else InputError '<what>: not a rigid transform: <why>'.");
 
   nb::class_<SequenceReader>(m, "SequenceReader", "Reads a sequence folder (lidar/, imu.csv, calib.yaml, ...).")
       .def(nb::init<Path>(), "dir"_a)

@@ -50,7 +50,7 @@ class SequenceFolder(Dataset):
         return self._reader.calibration().T_imu_lidar
 
     def gravity_m_s2(self) -> float:
-        return self._reader.calibration().gravity_m_s2
+        return self._reader.calibration().gravity_or_default()
 
     def groundtruth(self) -> Path | None:
         p = self.path / "groundtruth.tum"
