@@ -9,6 +9,7 @@
 #include "bindings.hpp"
 #include "farlio/core/device.hpp"
 #include "farlio/core/se3.hpp"
+#include "farlio/core/time.hpp"
 #include "farlio/core/trajectory.hpp"
 #include "farlio/core/types.hpp"
 
@@ -154,6 +155,7 @@ void bind_core(nb::module_& m) {
       .def("path_length_m", &Trajectory::path_length_m)
       .def("is_time_ordered", &Trajectory::is_time_ordered);
 
+  m.attr("NS_PER_S") = static_cast<std::int64_t>(kNsPerS);  // stamps are integer ns
   m.def("cuda_compiled", &cuda_compiled, "True if this build contains the CUDA backend.");
   m.def("cuda_device_count", &cuda_device_count, "Number of usable CUDA devices.");
 }

@@ -14,7 +14,8 @@ from typing import Any
 
 import numpy as np
 
-NS_PER_S = 10**9
+from farlio._core import NS_PER_S
+
 TUM_COLUMNS = 8                 # t x y z qx qy qz qw
 KITTI_COLUMNS = 12              # row-major 3x4 [R | t]
 KITTI_FRAME_PERIOD_S = 0.1      # stamps assumed for KITTI poses given without a times file

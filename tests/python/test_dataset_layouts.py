@@ -13,6 +13,7 @@ import pytest
 core = pytest.importorskip("farlio._core")
 
 import farlio  # noqa: E402
+from farlio._core import NS_PER_S  # noqa: E402
 from farlio.datasets import detect_format, open_dataset  # noqa: E402
 from farlio.datasets.kitti_raw import EARTH_RADIUS_M, OXTS_COLUMNS, parse_kitti_stamp  # noqa: E402
 from farlio.runner import replay_options, run_dataset  # noqa: E402
@@ -29,7 +30,6 @@ OXTS_ACCEL, OXTS_GYRO = 11, 17   # first column of ax ay az and of wx wy wz
 ORIGIN_LAT_DEG, ORIGIN_LON_DEG, ORIGIN_ALT_M = 49.0, 8.4, 110.0
 #: OXTS positions go through degrees of latitude/longitude and back
 OXTS_POSE_TOLERANCE_M = 1e-6
-NS_PER_S = 1_000_000_000
 
 
 class WithoutTimes:

@@ -85,3 +85,10 @@ def test_sequence_round_trip(tmp_path: Path) -> None:
     assert reader.groundtruth() is None
     with pytest.raises(core.InputError, match="lidar"):
         io.SequenceReader(tmp_path)
+
+
+def test_ns_per_s_is_one_integer_for_every_module() -> None:
+    from farlio.datasets import kitti_raw, pointcloud2
+    assert core.NS_PER_S == 1_000_000_000 and isinstance(core.NS_PER_S, int)
+    assert pointcloud2.NS_PER_S is core.NS_PER_S and kitti_raw.NS_PER_S is core.NS_PER_S
+
