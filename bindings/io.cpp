@@ -29,6 +29,20 @@ PcdEncoding encoding_from(const std::string& name) {
   return *enc;
 }
 
+TrajectoryFormat format_from(const std::string& name) {
+  const auto format = parse_trajectory_format(name);
+  if (format) return *format;
+  std::string names;
+  for (const auto& entry : kTrajectoryFormatNames) names += (names.empty() ? "" : ", ") + std::string(entry.first);
+  throw nb::value_error(("unknown trajectory format '" + name + "'; use one of " + names).c_str());
+}
+
+nb::tuple trajectory_format_names() {
+  nb::list names;
+  for (const auto& entry : kTrajectoryFormatNames) names.append(nb::str(entry.first.data(), entry.first.size()));
+  return nb::tuple(names);
+}
+
 void bind_point_clouds(nb::module_& m) {
   m.def("read_point_cloud", &read_point_cloud, "path"_a,
         "Reads a .pcd/.ply/.bin file (optionally .gz) into a Scan (stamps 0).");
@@ -56,6 +70,17 @@ void bind_trajectories(nb::module_& m) {
       },
       "path"_a, "stamps_ns"_a = nb::none(), "KITTI 3x4 poses; without stamps pose i gets i * 100 ms.");
   m.def("write_kitti", &write_kitti, "path"_a, "trajectory"_a);
+  m.def("read_stamps", &read_stamps, "path"_a,
+        "A times file: the first field of each line, seconds -> integer ns (exact for plain decimals).");
+  m.attr("TRAJECTORY_FORMATS") = trajectory_format_names();
+  m.def(
+      "read_trajectory",
+      [](const Path& path, const std::string& format, const std::optional<Path>& times) {
+        return read_trajectory(path, format_from(format), times);
+      },
+      "path"_a, "format"_a = "auto", "times"_a = nb::none(),
+      "A TUM or KITTI file ('auto': by the column count, 8 or 12); KITTI poses are stamped from the times "
+      "file (read_stamps), without one pose i gets i * 100 ms.");
   nb::class_<TrajectoryWriter>(m, "TrajectoryWriter", "Appends TUM lines, flushing each one.")
       .def(nb::init<const Path&>(), "path"_a)
       .def("append", &TrajectoryWriter::append, "stamp_ns"_a, "pose"_a)

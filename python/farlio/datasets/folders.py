@@ -95,14 +95,13 @@ class KittiOdometry(_FilesWithStamps):
             raise ValueError(f"{self.path / 'velodyne'}: no .bin scans")
         times = self.path / "times.txt"
         if times.exists():
-            stamps = [round(float(line) * 1e9) for line in times.read_text().split()]
+            stamps = _core.io.read_stamps(times)
             if len(stamps) != len(self._files):
                 raise ValueError(f"{times}: {len(stamps)} stamps for {len(self._files)} scans in velodyne/")
             # KITTI stamps can start at 0: shift so that the first scan has a positive start
             self._stamps = [s + DEFAULT_PERIOD_NS for s in stamps]
         else:
             self._stamps = [(i + 1) * DEFAULT_PERIOD_NS for i in range(len(self._files))]
-
 
 
 class PointCloudFolder(_FilesWithStamps):
