@@ -8,6 +8,7 @@
 #include <nanobind/stl/vector.h>
 
 #include "bindings.hpp"
+#include "repr.hpp"
 #include "farlio/io/calibration.hpp"
 #include "farlio/io/point_cloud_io.hpp"
 #include "farlio/io/rigid_transform.hpp"
@@ -41,6 +42,18 @@ nb::tuple trajectory_format_names() {
   nb::list names;
   for (const auto& entry : kTrajectoryFormatNames) names.append(nb::str(entry.first.data(), entry.first.size()));
   return nb::tuple(names);
+}
+
+std::string calibration_repr(const Calibration& c) {
+  Repr r("Calibration");
+  if (c.T_imu_lidar_by_name.empty()) {
+    r.field("T_imu_lidar", c.T_imu_lidar);
+  } else {
+    r.field("T_imu_lidar_by_name", c.T_imu_lidar_by_name);
+  }
+  r.field("gravity_m_s2", c.gravity_m_s2).field("imu_rate_hz", c.imu_rate_hz).field("lidar_rate_hz", c.lidar_rate_hz);
+  if (!c.source.empty()) r.field("source", c.source.string());
+  return r.str();
 }
 
 void bind_point_clouds(nb::module_& m) {
@@ -101,7 +114,8 @@ void bind_sequence(nb::module_& m) {
       .def("gravity_or_default", &Calibration::gravity_or_default, "gravity_m_s2, or 9.81 when not stated")
       .def("lidar_extrinsic", &Calibration::lidar_extrinsic, "names"_a,
            "T_imu_lidar of the LiDAR known by any of names (topic, frame id); InputError naming the entries "
-           "when the mapping has none of them.");
+           "when the mapping has none of them.")
+      .def("__repr__", &calibration_repr);
   m.def("read_calibration", &read_calibration, "path"_a);
   m.def("write_calibration", &write_calibration, "path"_a, "calibration"_a);
   m.def("rigid_transform_from_matrix", &rigid_transform_from_matrix, "m"_a, "what"_a,
