@@ -7,8 +7,10 @@
 #include <nanobind/stl/vector.h>
 
 #include "bindings.hpp"
+#include "repr.hpp"
 #include "farlio/core/device.hpp"
 #include "farlio/core/se3.hpp"
+#include "farlio/core/time.hpp"
 #include "farlio/core/trajectory.hpp"
 #include "farlio/core/types.hpp"
 
@@ -45,6 +47,32 @@ void assign(std::vector<T>& dst, const std::optional<In1<T>>& src, std::size_t n
 void set_points(Scan& s, const InPoints& p) {
   s.points.resize(p.shape(0));
   std::copy_n(p.data(), 3 * p.shape(0), s.points.data()->data());
+}
+
+std::string scan_repr(const Scan& s) {
+  std::vector<std::string> fields;  // the per-point arrays the scan has besides its points
+  if (!s.time_s.empty()) fields.emplace_back("time_s");
+  if (!s.intensity.empty()) fields.emplace_back("intensity");
+  if (!s.sensor_id.empty()) fields.emplace_back("sensor_id");
+  return Repr("Scan")
+      .item(std::to_string(s.size()) + " points")
+      .field("duration_s", s.duration_s())
+      .field("start_stamp_ns", s.start_stamp_ns)
+      .field("end_stamp_ns", s.end_stamp_ns)
+      .field("fields", fields)
+      .str();
+}
+
+std::string trajectory_repr(const Trajectory& t) {
+  Repr r("Trajectory");
+  r.item(std::to_string(t.size()) + " poses");
+  if (t.size() == 0) return r.str();
+  return r.field("first_stamp_ns", t[0].stamp_ns)
+      .field("last_stamp_ns", t[t.size() - 1].stamp_ns)
+      .field("path_length_m", t.path_length_m())
+      .field("first", t[0].pose)
+      .field("last", t[t.size() - 1].pose)
+      .str();
 }
 
 }  // namespace
@@ -88,9 +116,7 @@ void bind_core(nb::module_& m) {
       .def("__len__", &Scan::size)
       .def_prop_ro("duration_s", &Scan::duration_s)
       .def("remove_non_finite", &Scan::remove_non_finite, "Drops NaN/Inf points; returns how many.")
-      .def("__repr__", [](const Scan& s) {
-        return "Scan(" + std::to_string(s.size()) + " points, end_stamp_ns=" + std::to_string(s.end_stamp_ns) + ")";
-      });
+      .def("__repr__", &scan_repr);
 
   nb::class_<ImuSample>(m, "ImuSample", "One IMU reading in the body frame.")
       .def(nb::init<>())
@@ -102,7 +128,8 @@ void bind_core(nb::module_& m) {
           "stamp_ns"_a, "gyro_rad_s"_a, "accel_m_s2"_a)
       .def_rw("stamp_ns", &ImuSample::stamp_ns)
       .def_rw("gyro_rad_s", &ImuSample::gyro_rad_s)
-      .def_rw("accel_m_s2", &ImuSample::accel_m_s2);
+      .def_rw("accel_m_s2", &ImuSample::accel_m_s2)
+      .def("__repr__", attribute_repr({"stamp_ns", "gyro_rad_s", "accel_m_s2"}));
 
   nb::class_<SE3>(m, "SE3", "Rigid transform; tangent vectors are [translation; rotation].")
       .def(nb::init<>())
@@ -120,7 +147,8 @@ void bind_core(nb::module_& m) {
                    })
       .def("angle_rad", &SE3::angle_rad)
       .def("__mul__", [](const SE3& a, const SE3& b) { return a * b; })
-      .def("__mul__", [](const SE3& a, const Vec3d& p) { return Vec3d(a * p); });
+      .def("__mul__", [](const SE3& a, const Vec3d& p) { return Vec3d(a * p); })
+      .def("__repr__", [](const SE3& t) { return repr_value(t); });
 
   nb::class_<Trajectory>(m, "Trajectory", "Time-ordered poses of one frame in the world.")
       .def(nb::init<>())
@@ -152,8 +180,10 @@ void bind_core(nb::module_& m) {
       .def("interpolate_at", &Trajectory::interpolate_at, "stamp_ns"_a)
       .def("transformed", &Trajectory::transformed, "extrinsic"_a)
       .def("path_length_m", &Trajectory::path_length_m)
-      .def("is_time_ordered", &Trajectory::is_time_ordered);
+      .def("is_time_ordered", &Trajectory::is_time_ordered)
+      .def("__repr__", &trajectory_repr);
 
+  m.attr("NS_PER_S") = static_cast<std::int64_t>(kNsPerS);  // stamps are integer ns
   m.def("cuda_compiled", &cuda_compiled, "True if this build contains the CUDA backend.");
   m.def("cuda_device_count", &cuda_device_count, "Number of usable CUDA devices.");
 }

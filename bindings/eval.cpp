@@ -2,9 +2,11 @@
 #include <nanobind/eigen/dense.h>
 #include <nanobind/ndarray.h>
 #include <nanobind/stl/pair.h>
+#include <nanobind/stl/string.h>
 #include <nanobind/stl/vector.h>
 
 #include "bindings.hpp"
+#include "repr.hpp"
 #include "farlio/eval/metrics.hpp"
 
 namespace nb = nanobind;
@@ -28,6 +30,22 @@ nb::ndarray<nb::numpy, double> positions(const std::vector<SE3>& poses) {
   v.reserve(3 * poses.size());
   for (const auto& p : poses) v.insert(v.end(), p.translation().data(), p.translation().data() + 3);
   return owned_array(std::move(v), {poses.size(), 3});
+}
+
+/// The headline figures; the parts print themselves in full (result.ape, result.kitti_rpe, ...).
+std::string evaluation_repr(const EvaluationResult& r) {
+  return Repr("EvaluationResult")
+      .field("estimate_poses", r.estimate_poses)
+      .field("groundtruth_poses", r.groundtruth_poses)
+      .field("associated_poses", r.associated_poses)
+      .field("coverage", r.coverage)
+      .field("groundtruth_path_length_m", r.groundtruth_path_length_m)
+      .field("ape_translation_rmse_m", r.ape.translation_m.rmse)
+      .field("ape_rotation_rmse_deg", r.ape.rotation_deg.rmse)
+      .field("kitti_translation_pct", r.kitti_rpe.translation_pct)
+      .field("kitti_rotation_deg_per_100m", r.kitti_rpe.rotation_deg_per_100m)
+      .field("rpe_translation_rmse_m", r.rpe.translation_m.rmse)
+      .str();
 }
 
 void bind_options(nb::module_& m) {
@@ -68,11 +86,13 @@ void bind_results(nb::module_& m) {
       .def_ro("rmse", &ErrorStats::rmse)
       .def_ro("mean", &ErrorStats::mean)
       .def_ro("median", &ErrorStats::median)
-      .def_ro("max", &ErrorStats::max);
+      .def_ro("max", &ErrorStats::max)
+      .def("__repr__", attribute_repr({"count", "rmse", "mean", "median", "max"}));
   nb::class_<Alignment>(m, "Alignment")
       .def_ro("transform", &Alignment::transform)
       .def_ro("scale", &Alignment::scale)
-      .def_ro("rank_deficient", &Alignment::rank_deficient);
+      .def_ro("rank_deficient", &Alignment::rank_deficient)
+      .def("__repr__", attribute_repr({"transform", "scale", "rank_deficient"}));
   nb::class_<ApeResult>(m, "ApeResult")
       .def_ro("alignment", &ApeResult::alignment)
       .def_ro("translation_m", &ApeResult::translation_m)
@@ -81,23 +101,32 @@ void bind_results(nb::module_& m) {
       .def_ro("rotation_raw_deg", &ApeResult::rotation_raw_deg)
       .def_prop_ro("translation_errors_m", [](const ApeResult& r) { return to_numpy(r.translation_errors_m); }, nb::rv_policy::move)
       .def_prop_ro("rotation_errors_deg", [](const ApeResult& r) { return to_numpy(r.rotation_errors_deg); }, nb::rv_policy::move)
-      .def_prop_ro("aligned_positions_m", [](const ApeResult& r) { return positions(r.aligned_estimate); }, nb::rv_policy::move);
+      .def_prop_ro(
+          "aligned_positions_m", [](const ApeResult& r) { return positions(r.aligned_estimate); }, nb::rv_policy::move)
+      .def("__repr__", attribute_repr({"translation_m", "rotation_deg", "translation_raw_m", "rotation_raw_deg",
+                                       "alignment"}));
   nb::class_<KittiLengthError>(m, "KittiLengthError")
       .def_ro("length_m", &KittiLengthError::length_m)
       .def_ro("segment_count", &KittiLengthError::segment_count)
       .def_ro("translation_pct", &KittiLengthError::translation_pct)
-      .def_ro("rotation_deg_per_100m", &KittiLengthError::rotation_deg_per_100m);
+      .def_ro("rotation_deg_per_100m", &KittiLengthError::rotation_deg_per_100m)
+      .def("__repr__", attribute_repr({"length_m", "segment_count", "translation_pct", "rotation_deg_per_100m"}));
   nb::class_<KittiRpeResult>(m, "KittiRpeResult")
       .def_ro("segment_lengths_m", &KittiRpeResult::segment_lengths_m)
       .def_ro("segment_count", &KittiRpeResult::segment_count)
       .def_ro("translation_pct", &KittiRpeResult::translation_pct)
       .def_ro("rotation_deg_per_100m", &KittiRpeResult::rotation_deg_per_100m)
-      .def_ro("per_length", &KittiRpeResult::per_length);
+      .def_ro("per_length", &KittiRpeResult::per_length)
+      .def("__repr__", attribute_repr({"segment_count", "translation_pct", "rotation_deg_per_100m",
+                                       "segment_lengths_m"}));
   nb::class_<DeltaRpeResult>(m, "DeltaRpeResult")
       .def_ro("pairs", &DeltaRpeResult::pairs)
       .def_ro("translation_m", &DeltaRpeResult::translation_m)
       .def_ro("rotation_deg", &DeltaRpeResult::rotation_deg)
-      .def_prop_ro("translation_errors_m", [](const DeltaRpeResult& r) { return to_numpy(r.translation_errors_m); }, nb::rv_policy::move);
+      .def_prop_ro(
+          "translation_errors_m", [](const DeltaRpeResult& r) { return to_numpy(r.translation_errors_m); },
+          nb::rv_policy::move)
+      .def("__repr__", attribute_repr({"translation_m", "rotation_deg"}));  // translation_m.count: the pairs
   nb::class_<EvaluationResult>(m, "EvaluationResult")
       .def_ro("estimate_poses", &EvaluationResult::estimate_poses)
       .def_ro("groundtruth_poses", &EvaluationResult::groundtruth_poses)
@@ -108,7 +137,8 @@ void bind_results(nb::module_& m) {
       .def_prop_ro("groundtruth_positions_m", [](const EvaluationResult& r) { return positions(r.groundtruth); }, nb::rv_policy::move)
       .def_ro("ape", &EvaluationResult::ape)
       .def_ro("kitti_rpe", &EvaluationResult::kitti_rpe)
-      .def_ro("rpe", &EvaluationResult::rpe);
+      .def_ro("rpe", &EvaluationResult::rpe)
+      .def("__repr__", &evaluation_repr);
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 // Bindings of farlio::io: point cloud files, trajectory files and the sequence folder.
 // Paths are str or os.PathLike; bad input raises farlio._core.InputError (a ValueError).
+#include <nanobind/eigen/dense.h>
 #include <nanobind/stl/filesystem.h>
 #include <nanobind/stl/map.h>
 #include <nanobind/stl/optional.h>
@@ -7,8 +8,10 @@
 #include <nanobind/stl/vector.h>
 
 #include "bindings.hpp"
+#include "repr.hpp"
 #include "farlio/io/calibration.hpp"
 #include "farlio/io/point_cloud_io.hpp"
+#include "farlio/io/rigid_transform.hpp"
 #include "farlio/io/sequence.hpp"
 #include "farlio/io/trajectory_io.hpp"
 
@@ -25,6 +28,32 @@ PcdEncoding encoding_from(const std::string& name) {
   const auto enc = parse_pcd_encoding(name);
   if (!enc) throw nb::value_error(("unknown PCD encoding '" + name + "' (ascii, binary or binary_compressed)").c_str());
   return *enc;
+}
+
+TrajectoryFormat format_from(const std::string& name) {
+  const auto format = parse_trajectory_format(name);
+  if (format) return *format;
+  std::string names;
+  for (const auto& entry : kTrajectoryFormatNames) names += (names.empty() ? "" : ", ") + std::string(entry.first);
+  throw nb::value_error(("unknown trajectory format '" + name + "'; use one of " + names).c_str());
+}
+
+nb::tuple trajectory_format_names() {
+  nb::list names;
+  for (const auto& entry : kTrajectoryFormatNames) names.append(nb::str(entry.first.data(), entry.first.size()));
+  return nb::tuple(names);
+}
+
+std::string calibration_repr(const Calibration& c) {
+  Repr r("Calibration");
+  if (c.T_imu_lidar_by_name.empty()) {
+    r.field("T_imu_lidar", c.T_imu_lidar);
+  } else {
+    r.field("T_imu_lidar_by_name", c.T_imu_lidar_by_name);
+  }
+  r.field("gravity_m_s2", c.gravity_m_s2).field("imu_rate_hz", c.imu_rate_hz).field("lidar_rate_hz", c.lidar_rate_hz);
+  if (!c.source.empty()) r.field("source", c.source.string());
+  return r.str();
 }
 
 void bind_point_clouds(nb::module_& m) {
@@ -54,6 +83,17 @@ void bind_trajectories(nb::module_& m) {
       },
       "path"_a, "stamps_ns"_a = nb::none(), "KITTI 3x4 poses; without stamps pose i gets i * 100 ms.");
   m.def("write_kitti", &write_kitti, "path"_a, "trajectory"_a);
+  m.def("read_stamps", &read_stamps, "path"_a,
+        "A times file: the first field of each line, seconds -> integer ns (exact for plain decimals).");
+  m.attr("TRAJECTORY_FORMATS") = trajectory_format_names();
+  m.def(
+      "read_trajectory",
+      [](const Path& path, const std::string& format, const std::optional<Path>& times) {
+        return read_trajectory(path, format_from(format), times);
+      },
+      "path"_a, "format"_a = "auto", "times"_a = nb::none(),
+      "A TUM or KITTI file ('auto': by the column count, 8 or 12); KITTI poses are stamped from the times "
+      "file (read_stamps), without one pose i gets i * 100 ms.");
   nb::class_<TrajectoryWriter>(m, "TrajectoryWriter", "Appends TUM lines, flushing each one.")
       .def(nb::init<const Path&>(), "path"_a)
       .def("append", &TrajectoryWriter::append, "stamp_ns"_a, "pose"_a)
@@ -62,14 +102,25 @@ void bind_trajectories(nb::module_& m) {
 }
 
 void bind_sequence(nb::module_& m) {
-  nb::class_<Calibration>(m, "Calibration", "calib.yaml: extrinsic, gravity, sensor rates.")
+  nb::class_<Calibration>(m, "Calibration", "calib.yaml: extrinsic(s), gravity, sensor rates.")
       .def(nb::init<>())
-      .def_rw("T_imu_lidar", &Calibration::T_imu_lidar)
-      .def_rw("gravity_m_s2", &Calibration::gravity_m_s2)
+      .def_rw("T_imu_lidar", &Calibration::T_imu_lidar, "one LiDAR: maps its points into the IMU (body) frame")
+      .def_rw("T_imu_lidar_by_name", &Calibration::T_imu_lidar_by_name,
+              "several LiDARs: {topic or frame id: T_imu_lidar} (a copy); empty for one LiDAR")
+      .def_rw("gravity_m_s2", &Calibration::gravity_m_s2, "None when the file does not state it")
       .def_rw("imu_rate_hz", &Calibration::imu_rate_hz)
-      .def_rw("lidar_rate_hz", &Calibration::lidar_rate_hz);
+      .def_rw("lidar_rate_hz", &Calibration::lidar_rate_hz)
+      .def_rw("source", &Calibration::source, "the file it was read from")
+      .def("gravity_or_default", &Calibration::gravity_or_default, "gravity_m_s2, or 9.81 when not stated")
+      .def("lidar_extrinsic", &Calibration::lidar_extrinsic, "names"_a,
+           "T_imu_lidar of the LiDAR known by any of names (topic, frame id); InputError naming the entries "
+           "when the mapping has none of them.")
+      .def("__repr__", &calibration_repr);
   m.def("read_calibration", &read_calibration, "path"_a);
   m.def("write_calibration", &write_calibration, "path"_a, "calibration"_a);
+  m.def("rigid_transform_from_matrix", &rigid_transform_from_matrix, "m"_a, "what"_a,
+        "The SE3 of a 4x4 matrix if it is rigid (finite, rotation orthonormal, last row 0 0 0 1, within the "
+        "tolerance of calib.yaml); else InputError '<what>: not a rigid transform: <why>'.");
 
   nb::class_<SequenceReader>(m, "SequenceReader", "Reads a sequence folder (lidar/, imu.csv, calib.yaml, ...).")
       .def(nb::init<Path>(), "dir"_a)

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "bindings.hpp"
+#include "repr.hpp"
 #include "farlio/core/config_fields.hpp"
 #include "farlio/pipeline/odometry.hpp"
 #include "farlio/pipeline/online_odometry.hpp"
@@ -151,7 +152,9 @@ void bind_pipeline(nb::module_& m) {
       .def_ro("registration_s", &pipeline::FrameTimings::registration_s)
       .def_ro("map_update_s", &pipeline::FrameTimings::map_update_s)
       .def_ro("total_s", &pipeline::FrameTimings::total_s)
-      .def_ro("device_timed", &pipeline::FrameTimings::device_timed, "stage times from CUDA events");
+      .def_ro("device_timed", &pipeline::FrameTimings::device_timed, "stage times from CUDA events")
+      .def("__repr__", attribute_repr({"preprocess_s", "covariance_s", "registration_s", "map_update_s", "total_s",
+                                       "device_timed"}));
 
   nb::class_<pipeline::FrameResult>(m, "FrameResult", "What the scan pipeline made of one scan.")
       .def_ro("stamp_ns", &pipeline::FrameResult::stamp_ns)
@@ -172,7 +175,10 @@ void bind_pipeline(nb::module_& m) {
       .def_ro("source_points", &pipeline::FrameResult::source_points)
       .def_ro("map_voxels", &pipeline::FrameResult::map_voxels)
       .def_ro("map_points", &pipeline::FrameResult::map_points)
-      .def_ro("timings", &pipeline::FrameResult::timings);
+      .def_ro("timings", &pipeline::FrameResult::timings)
+      .def("__repr__", attribute_repr({"stamp_ns", "pose", "registered", "converged", "iterations", "inliers",
+                                       "sigma_m", "density_limit", "input_points", "kept_points", "source_points",
+                                       "map_voxels", "map_points", "timings"}));
 
   nb::class_<registration::RegistrationResult>(m, "RegistrationResult", "Pose with the Gauss-Newton system.")
       .def_ro("pose", &registration::RegistrationResult::pose)
@@ -183,7 +189,9 @@ void bind_pipeline(nb::module_& m) {
       .def_prop_ro("hessian", [](const registration::RegistrationResult& r) { return r.system.H; })
       .def_prop_ro("gradient", [](const registration::RegistrationResult& r) { return r.system.b; })
       .def_prop_ro("error", [](const registration::RegistrationResult& r) { return r.system.error; })
-      .def_prop_ro("inliers", [](const registration::RegistrationResult& r) { return r.system.inliers; });
+      .def_prop_ro("inliers", [](const registration::RegistrationResult& r) { return r.system.inliers; })
+      .def("__repr__", attribute_repr({"pose", "iterations", "converged", "budget_exceeded", "time_s", "error",
+                                       "inliers"}));
 
   m.def(
       "register_pair",
@@ -210,7 +218,9 @@ void bind_pipeline(nb::module_& m) {
       .def_ro("drop_reason", &pipeline::OdometryFrame::drop_reason)
       .def_ro("started_ns", &pipeline::OdometryFrame::started_ns)
       .def_ro("available_ns", &pipeline::OdometryFrame::available_ns)
-      .def_ro("guess_from_fusion", &pipeline::OdometryFrame::guess_from_fusion);
+      .def_ro("guess_from_fusion", &pipeline::OdometryFrame::guess_from_fusion)
+      .def("__repr__", attribute_repr({"processed", "fused", "drop_reason", "started_ns", "available_ns",
+                                       "guess_from_fusion", "body_pose", "scan"}));
   nb::class_<fusion::FusionStats>(m, "FusionStats")
       .def_ro("steps", &fusion::FusionStats::steps)
       .def_ro("lidar_groups_accepted", &fusion::FusionStats::lidar_groups_accepted)
@@ -221,7 +231,10 @@ void bind_pipeline(nb::module_& m) {
       .def_ro("accel_in_g", &fusion::FusionStats::accel_in_g)
       .def_ro("accel_unit_message", &fusion::FusionStats::accel_unit_message)
       .def_ro("gyro_bias_rad_s", &fusion::FusionStats::gyro_bias_rad_s)
-      .def_ro("last_warning", &fusion::FusionStats::last_warning);
+      .def_ro("last_warning", &fusion::FusionStats::last_warning)
+      .def("__repr__", attribute_repr({"steps", "lidar_groups_accepted", "lidar_groups_rejected", "reinitializations",
+                                       "imu_gaps", "imu_samples_dropped", "accel_in_g", "gyro_bias_rad_s",
+                                       "last_warning"}));
   nb::class_<PyOdometry>(m, "Odometry",
                          "LiDAR-inertial odometry replayed on a simulated clock (LiDAR-only without IMU).")
       .def(nb::init<const Config&, const SE3&, double, std::vector<ImuSample>, const pipeline::ReplayOptions&>(),
@@ -260,7 +273,8 @@ void bind_pipeline(nb::module_& m) {
   nb::class_<pipeline::OdometrySample>(m, "OdometrySample", "One 10 ms sample of the fused odometry.")
       .def_ro("stamp_ns", &pipeline::OdometrySample::stamp_ns)
       .def_ro("body_pose", &pipeline::OdometrySample::body_pose)
-      .def_ro("velocity_body_m_s", &pipeline::OdometrySample::velocity_body_m_s);
+      .def_ro("velocity_body_m_s", &pipeline::OdometrySample::velocity_body_m_s)
+      .def("__repr__", attribute_repr({"stamp_ns", "body_pose", "velocity_body_m_s"}));
   nb::class_<PyOnlineOdometry>(m, "OnlineOdometry",
                                "LIO for live data: push IMU samples and scans as they arrive (any thread); the scan "
                                "pipeline runs on a worker; poll the 100 Hz odometry and the per-scan frames.")

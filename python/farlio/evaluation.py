@@ -1,4 +1,4 @@
-"""Trajectory evaluation against ground truth: file reading, the C++ metrics, eval.json and eval.png.
+"""Trajectory evaluation against ground truth: the C++ readers and metrics, eval.json and eval.png.
 
 The metrics themselves (association, APE, KITTI-style and evo-style RPE, coverage) are computed by
 ``farlio._core.eval.evaluate``; see docs/evaluation.md for their definitions.
@@ -8,17 +8,14 @@ from __future__ import annotations
 import argparse
 import json
 import math
-from decimal import Decimal
 from pathlib import Path
-from typing import Any
+from typing import Any, Sequence
 
-import numpy as np
+from farlio import _core
+from farlio._core import NS_PER_S
 
-NS_PER_S = 10**9
-TUM_COLUMNS = 8                 # t x y z qx qy qz qw
-KITTI_COLUMNS = 12              # row-major 3x4 [R | t]
-KITTI_FRAME_PERIOD_S = 0.1      # stamps assumed for KITTI poses given without a times file
-FORMATS = ("auto", "tum", "kitti")
+#: trajectory file formats ("auto": TUM or KITTI by the column count), as the C++ reader names them
+FORMATS = tuple(_core.io.TRAJECTORY_FORMATS)
 RPE_UNITS = ("frames", "m")
 JSON_NAME = "eval.json"
 PLOT_NAME = "eval.png"
@@ -26,80 +23,12 @@ PLOT_SIZE_IN = (12.0, 5.0)
 PLOT_DPI = 120
 
 
-# ---- reading ----------------------------------------------------------------------------------
-
-def _data_rows(path: Path) -> list[list[str]]:
-    rows = []
-    for line in Path(path).read_text().splitlines():
-        line = line.strip()
-        if line and not line.startswith("#"):
-            rows.append(line.replace(",", " ").split())
-    if not rows:
-        raise ValueError(f"{path}: no poses")
-    return rows
-
-
-def _stamp_ns(token: str) -> int:
-    """Seconds as written in the file -> integer nanoseconds, without float rounding."""
-    return int((Decimal(token) * NS_PER_S).to_integral_value())
-
-
-def read_tum(path: Path) -> tuple[np.ndarray, np.ndarray]:
-    """TUM file -> (stamps_ns (N,) int64, poses (N, 4, 4)), through the C++ reader (exact stamps,
-    errors that name the file and line)."""
-    from farlio import _core
-
-    traj = _core.io.read_tum(Path(path))
-    return np.asarray(traj.stamps_ns), traj.matrices()
-
-
-def read_kitti(path: Path, times: Path | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """KITTI poses (12 values a line) and an optional times file (seconds a line) -> (stamps_ns, poses).
-    Without a times file frame k gets the stamp k * KITTI_FRAME_PERIOD_S."""
-    from farlio import _core
-
-    stamps = None
-    if times is not None:
-        stamps = [_stamp_ns(r[0]) for r in _data_rows(times)]
-    traj = _core.io.read_kitti(Path(path), stamps)  # without stamps: k * KITTI_FRAME_PERIOD_S
-    return np.asarray(traj.stamps_ns), traj.matrices()
-
-
-def _detect_format(path: Path) -> str:
-    columns = len(_data_rows(path)[0])
-    if columns == TUM_COLUMNS:
-        return "tum"
-    if columns == KITTI_COLUMNS:
-        return "kitti"
-    raise ValueError(f"{path}: {columns} columns is neither TUM ({TUM_COLUMNS}) nor KITTI ({KITTI_COLUMNS})")
-
-
-def read_trajectory(path: Path, fmt: str = "auto", times: Path | None = None) -> tuple[np.ndarray, np.ndarray]:
-    if fmt not in FORMATS:
-        raise ValueError(f"unknown trajectory format {fmt!r}; use one of {FORMATS}")
-    fmt = _detect_format(path) if fmt == "auto" else fmt
-    return read_tum(path) if fmt == "tum" else read_kitti(path, times)
-
-
-def to_trajectory(stamps_ns: np.ndarray, poses: np.ndarray):
-    """(stamps_ns, (N,4,4) poses) -> farlio._core.Trajectory."""
-    from farlio import _core
-
-    traj = _core.Trajectory()
-    for stamp, pose in zip(stamps_ns, poses):
-        traj.push_back(int(stamp), _core.SE3.from_matrix(np.ascontiguousarray(pose)))
-    return traj
-
-
-# ---- evaluation -------------------------------------------------------------------------------
-
 def make_options(*, max_time_diff_s: float | None = None, nearest: bool = False, align_scale: bool = False,
                  kitti_step: int | None = None, segment_lengths_m: list[float] | None = None,
                  rpe_delta: float | None = None, rpe_unit: str = "frames", rpe_all_pairs: bool = False,
-                 rpe_pairs_from_estimate: bool = False, scan_stamps_ns: np.ndarray | None = None):
+                 rpe_pairs_from_estimate: bool = False, scan_stamps_ns: Sequence[int] | None = None):
     """EvalOptions from keyword arguments; None keeps the C++ default."""
-    from farlio._core import eval as ev
-
+    ev = _core.eval
     o = ev.EvalOptions()
     assoc = o.association
     if max_time_diff_s is not None:
@@ -221,16 +150,14 @@ def evaluate_files(estimate: Path, groundtruth: Path, out_dir: Path | None = Non
     stamps in seconds (coverage reference; default the ground-truth stamps). ``options`` go to
     make_options(). Writes eval.json (and eval.png if plot) into out_dir when given.
     """
-    from farlio._core import eval as ev
-
     estimate, groundtruth = Path(estimate), Path(groundtruth)
     est_times = estimate_times or groundtruth_times
     gt_times = groundtruth_times or estimate_times
-    est = read_trajectory(estimate, fmt, est_times)
-    gt = read_trajectory(groundtruth, fmt, gt_times)
+    est = _core.io.read_trajectory(estimate, fmt, est_times)
+    gt = _core.io.read_trajectory(groundtruth, fmt, gt_times)
     if scan_stamps is not None:
-        options["scan_stamps_ns"] = np.array([_stamp_ns(r[0]) for r in _data_rows(scan_stamps)], dtype=np.int64)
-    result = ev.evaluate(to_trajectory(*est), to_trajectory(*gt), make_options(**options))
+        options["scan_stamps_ns"] = _core.io.read_stamps(scan_stamps)
+    result = _core.eval.evaluate(est, gt, make_options(**options))
     summary = result_to_dict(result)
     summary["estimate_file"] = str(estimate)
     summary["groundtruth_file"] = str(groundtruth)

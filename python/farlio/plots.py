@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .evaluation import read_trajectory
+from farlio import _core
 
 TRAJECTORY_PNG = "trajectory.png"
 LATENCY_PNG = "latency.png"
@@ -32,7 +32,7 @@ def plot_trajectory(estimate: Path, path: Path, groundtruth: Path | None = None)
     for file, label, style in ((groundtruth, "ground truth", "k--"), (estimate, "estimate", "C0-")):
         if file is None or not Path(file).exists():
             continue
-        _, poses = read_trajectory(Path(file))
+        poses = _core.io.read_trajectory(Path(file)).matrices()
         if len(poses):
             ax.plot(poses[:, 0, 3], poses[:, 1, 3], style, label=label, linewidth=1.2)
     ax.set_xlabel("x [m]")

@@ -15,11 +15,11 @@ Outputs in the output folder (every trajectory file names its frame):
 """
 from __future__ import annotations
 
-import csv
 import json
 import math
 import sys
 import time
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
 
@@ -31,18 +31,22 @@ from farlio import _core
 from .config import config_to_yaml
 from .datasets import Dataset
 from .progress import Progress
+from .timing_csv import MS_PER_S, TIMING_CSV, TimingCsv
 
-MS_PER_S = 1e3
 #: values of --device and of the config field device
 DEVICES = ("auto", "cpu", "cuda")
-#: timing.csv's stage_clock: the stage times are wall clock (CPU) or CUDA events (GPU timeline)
-STAGE_CLOCKS = {False: "wall", True: "cuda_events"}
-TIMING_COLUMNS = ["frame", "stamp_ns", "input_points", "kept_points", "source_points", "registered", "converged",
-                  "iterations", "inliers", "sigma_m", "density_limit", "map_voxels", "map_points",
-                  "preprocess_ms", "covariance_ms", "registration_ms", "map_update_ms", "total_ms",
-                  "stage_clock", "fused", "guess_from_fusion", "latency_ms", "drop_reason"]
 LATENCY_MODELS = {"measured": _core.LatencyModel.Measured, "zero": _core.LatencyModel.Zero,
                   "fixed": _core.LatencyModel.Fixed}
+CONFIG_YAML, SUMMARY_JSON = "config.yaml", "summary.json"
+SCANS_LIDAR_TUM, SCANS_BODY_TUM, ODOMETRY_TUM = "scans_lidar.tum", "scans_body.tum", "odometry_body.tum"
+SCANS_LIDAR_KITTI = "scans_lidar_kitti.txt"
+MAP_PLY, MAP_PCD = "map.ply", "map.pcd"
+GROUNDTRUTH_SCANS_TUM = "groundtruth_scans.tum"
+EVAL_SCANS_DIR, EVAL_ODOMETRY_DIR = "eval_scans", "eval_odometry"
+MEDIAN_PERCENTILE, TAIL_PERCENTILE = 50, 99
+#: fewer registered poses than this are not evaluated
+MIN_EVALUATED_POSES = 3
+BYTES_PER_MIB = 2**20
 
 
 def _percentile(values: list[float], q: float) -> float:
@@ -72,157 +76,215 @@ def run_dataset(dataset: Dataset, out_dir: Path, config: Any = None, *, max_fram
 
     use_imu False runs LiDAR-only even when the recording has an IMU; on_frame(i, scan, frame
     result) is called after every processed scan (a live view)."""
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    config = config or _core.Config()
-    # written first so that a run that dies still says its parameters; rewritten at the end
-    # with the effective values (the voxel size is fixed at the first scan)
-    (out_dir / "config.yaml").write_text(config_to_yaml(config))
-    for w in dataset.warnings():
-        _warn(w)
-
-    T_imu_lidar = dataset.T_imu_lidar()
-    imu = dataset.imu() if use_imu else []
-    odo = _core.Odometry(config, T_imu_lidar, dataset.gravity_m_s2(), imu, options or replay_options())
-    if odo.device_message:
-        print(f"farlio: {odo.device_message}", file=sys.stderr)
-    elif odo.device == "cuda":
-        print(f"farlio: CUDA backend, {odo.map_memory_bytes / 2**20:.0f} MiB of device memory preallocated",
-              file=sys.stderr)
-    lidar_tum = _core.io.TrajectoryWriter(out_dir / "scans_lidar.tum")
-    body_tum = _core.io.TrajectoryWriter(out_dir / "scans_body.tum")
-    odom_tum = _core.io.TrajectoryWriter(out_dir / "odometry_body.tum") if odo.inertial else None
-    lidar_traj = farlio.Trajectory()
-
-    n = len(dataset) if max_frames is None else min(len(dataset), max_frames)
-    totals_ms: list[float] = []
-    converged = registered = skipped = dropped = 0
-    last_stamp = None
-    bar = Progress(n, dataset.name, progress)
-    start = time.perf_counter()
-    with open(out_dir / "timing.csv", "w", newline="", buffering=1) as f:
-        writer = csv.writer(f)
-        writer.writerow(TIMING_COLUMNS)
-        for i in range(n):
-            try:
-                scan = dataset.scan(i)
-            except (ValueError, OSError) as e:
-                skipped += 1
-                _warn(f"skipping {dataset.scan_source(i)}: {e}")
-                continue
-            if last_stamp is not None and scan.end_stamp_ns <= last_stamp:
-                skipped += 1
-                _warn(f"skipping {dataset.scan_source(i)}: its stamp {scan.end_stamp_ns} ns is not after the "
-                      f"previous scan's {last_stamp} ns (time going backwards)")
-                continue
-            removed = scan.remove_non_finite()
-            if removed:
-                _warn(f"{dataset.scan_source(i)}: dropped {removed} points with NaN/Inf coordinates or times")
-            fr = odo.process(scan)
-            last_stamp = scan.end_stamp_ns
-            if odom_tum is not None:
-                for stamp, pose in odo.take_odometry():
-                    odom_tum.append(stamp, pose)
-            if not fr.processed:
-                dropped += 1
-                writer.writerow([i, scan.end_stamp_ns] + [""] * (len(TIMING_COLUMNS) - 3) + [fr.drop_reason])
-                continue
-            r = fr.scan
-            lidar_tum.append(r.stamp_ns, r.pose)
-            body_tum.append(r.stamp_ns, fr.body_pose)
-            lidar_traj.push_back(r.stamp_ns, r.pose)
-            t = r.timings
-            totals_ms.append(t.total_s * MS_PER_S)
-            registered += int(r.registered)
-            converged += int(r.registered and r.converged)
-            dropped += int(bool(fr.drop_reason))
-            writer.writerow([i, r.stamp_ns, r.input_points, r.kept_points, r.source_points, int(r.registered),
-                             int(r.converged), r.iterations, r.inliers, f"{r.sigma_m:.4f}", r.density_limit,
-                             r.map_voxels, r.map_points] +
-                            [f"{v * MS_PER_S:.3f}" for v in (t.preprocess_s, t.covariance_s, t.registration_s,
-                                                             t.map_update_s, t.total_s)] +
-                            [STAGE_CLOCKS[t.device_timed], int(fr.fused), int(fr.guess_from_fusion),
-                             f"{(fr.available_ns - fr.started_ns) / 1e6:.3f}", fr.drop_reason])
-            if on_frame is not None:
-                on_frame(i, scan, fr)
-            bar.update(i + 1, f"{t.total_s * MS_PER_S:6.1f} ms")
-        if last_stamp is not None:
-            odo.finish(last_stamp)
-            if odom_tum is not None:
-                for stamp, pose in odo.take_odometry():
-                    odom_tum.append(stamp, pose)
-    bar.close()
-    wall_s = time.perf_counter() - start
-
-    if len(lidar_traj) > 0:
-        first_inv = lidar_traj[0][1].inverse()
-        rel = farlio.Trajectory()
-        for k in range(len(lidar_traj)):
-            stamp, pose = lidar_traj[k]
-            rel.push_back(stamp, first_inv * pose)
-        _core.io.write_kitti(out_dir / "scans_lidar_kitti.txt", rel)
+    run = OdometryRun(dataset, Path(out_dir), config or _core.Config())
+    run.open_outputs(options or replay_options(), use_imu)
+    run.run_frames(max_frames, progress, on_frame)
+    run.export_kitti()
     if save_map:
-        submap = farlio.Scan(odo.map_points())
-        _core.io.write_ply(out_dir / "map.ply", submap)
-        _core.io.write_pcd(out_dir / "map.pcd", submap)
-
-    summary: dict[str, Any] = {
-        "dataset": str(dataset.path),
-        "mode": "lidar-inertial" if odo.inertial else "lidar-only",
-        "frames": n,
-        "processed": len(totals_ms),
-        "skipped": skipped,
-        "dropped": dropped,
-        "registered": registered,
-        "converged_fraction": converged / registered if registered else float("nan"),
-        "latency_ms": {"median": _percentile(totals_ms, 50), "p99": _percentile(totals_ms, 99),
-                       "max": max(totals_ms) if totals_ms else float("nan"),
-                       "mean": float(np.mean(totals_ms)) if totals_ms else float("nan")},
-        "wall_s": wall_s,
-        "rate_hz": len(totals_ms) / wall_s if wall_s > 0 else float("nan"),
-        "device": odo.device,
-        "map_memory_bytes": odo.map_memory_bytes,
-        "threads": config.get("num_threads"),
-    }
-    stats = odo.fusion_stats
-    if stats is not None:
-        summary["fusion"] = {"lidar_groups_accepted": stats.lidar_groups_accepted,
-                             "lidar_groups_rejected": stats.lidar_groups_rejected,
-                             "reinitializations": stats.reinitializations, "imu_gaps": stats.imu_gaps,
-                             "imu_samples_dropped": stats.imu_samples_dropped, "accel_in_g": stats.accel_in_g,
-                             "gyro_bias_rad_s": list(stats.gyro_bias_rad_s)}
-        if stats.accel_in_g:
-            _warn(stats.accel_unit_message)
-        if stats.imu_gaps:
-            _warn(f"{stats.imu_gaps} IMU gap(s): no sample for longer than fusion.imu_gap_limit_s "
-                  "(the last input was held)")
-    _evaluate(summary, dataset, out_dir, groundtruth, plot, len(lidar_traj))
-    if plot and totals_ms:
-        from .plots import plot_run
-        plot_run(out_dir, summary.get("accuracy", {}).get("groundtruth_file"))
-    (out_dir / "config.yaml").write_text(config_to_yaml(odo.effective_config))
-    summary["voxel_size_m"] = float(odo.effective_config.get("map.voxel_size_m"))
-    (out_dir / "summary.json").write_text(json.dumps(summary, indent=2, default=_json_default))
+        run.save_map()
+    summary = run.summarise()
+    run.evaluate(summary, groundtruth, plot)
+    if plot:
+        run.plot(summary)
+    run.write_summary(summary)
     return summary
 
 
-def _evaluate(summary: dict[str, Any], dataset: Dataset, out_dir: Path, groundtruth: Path | None, plot: bool,
-              poses: int) -> None:
-    from .evaluation import evaluate_files
-    if poses < 3:
-        return
-    gt_scans = groundtruth
-    if gt_scans is None and (Path(dataset.path) / "groundtruth_scans.tum").exists():
-        gt_scans = Path(dataset.path) / "groundtruth_scans.tum"
-    if gt_scans is None:
-        gt_scans = dataset.groundtruth()  # a dense ground truth (MulRan): interpolated at the scan stamps
-    if gt_scans is not None:
-        summary["accuracy"] = evaluate_files(out_dir / "scans_body.tum", Path(gt_scans), out_dir / "eval_scans",
-                                             plot=plot)
-    gt_dense = groundtruth or dataset.groundtruth()
-    if gt_dense is not None and (out_dir / "odometry_body.tum").exists():
-        summary["accuracy_odometry"] = evaluate_files(out_dir / "odometry_body.tum", Path(gt_dense),
-                                                      out_dir / "eval_odometry", plot=plot)
+@dataclass
+class FrameCounts:
+    """What happened to the frames so far."""
+
+    totals_ms: list[float] = field(default_factory=list)  # processing time of every processed frame
+    registered: int = 0
+    converged: int = 0
+    skipped: int = 0
+    dropped: int = 0
+
+
+class OdometryRun:
+    """The odometry over one dataset and the files it writes as it goes (run_dataset's steps)."""
+
+    def __init__(self, dataset: Dataset, out_dir: Path, config: Any):
+        self.dataset, self.out_dir, self.config = dataset, out_dir, config
+        self.frames = 0
+        self.counts = FrameCounts()
+        self.lidar_poses = farlio.Trajectory()
+        self.last_stamp: int | None = None
+        self.wall_s = 0.0
+
+    def open_outputs(self, options: Any, use_imu: bool) -> None:
+        """config.yaml (written first so that a run that dies still says its parameters; rewritten
+        at the end with the effective values), the odometry, and the trajectory files."""
+        self.out_dir.mkdir(parents=True, exist_ok=True)
+        (self.out_dir / CONFIG_YAML).write_text(config_to_yaml(self.config))
+        for w in self.dataset.warnings():
+            _warn(w)
+        imu = self.dataset.imu() if use_imu else []
+        self.odo = _core.Odometry(self.config, self.dataset.T_imu_lidar(), self.dataset.gravity_m_s2(), imu, options)
+        if self.odo.device_message:
+            print(f"farlio: {self.odo.device_message}", file=sys.stderr)
+        elif self.odo.device == "cuda":
+            print(f"farlio: CUDA backend, {self.odo.map_memory_bytes / BYTES_PER_MIB:.0f} MiB of device memory "
+                  "preallocated", file=sys.stderr)
+        self.lidar_tum = _core.io.TrajectoryWriter(self.out_dir / SCANS_LIDAR_TUM)
+        self.body_tum = _core.io.TrajectoryWriter(self.out_dir / SCANS_BODY_TUM)
+        self.odom_tum = _core.io.TrajectoryWriter(self.out_dir / ODOMETRY_TUM) if self.odo.inertial else None
+
+    def run_frames(self, max_frames: int | None, progress: bool | None,
+                   on_frame: Callable[[int, Any, Any], None] | None) -> None:
+        self.frames = len(self.dataset) if max_frames is None else min(len(self.dataset), max_frames)
+        bar = Progress(self.frames, self.dataset.name, progress)
+        start = time.perf_counter()
+        with TimingCsv(self.out_dir / TIMING_CSV) as timing:
+            for i in range(self.frames):
+                self.run_frame(i, timing, bar, on_frame)
+            if self.last_stamp is not None:
+                self.odo.finish(self.last_stamp)
+                self.write_odometry()
+        bar.close()
+        self.wall_s = time.perf_counter() - start
+
+    def run_frame(self, i: int, timing: TimingCsv, bar: Progress,
+                  on_frame: Callable[[int, Any, Any], None] | None) -> None:
+        scan = self.next_scan(i)
+        if scan is None:
+            return
+        fr = self.odo.process(scan)
+        self.last_stamp = scan.end_stamp_ns
+        self.write_odometry()
+        timing.write(i, scan, fr)
+        if not fr.processed:
+            self.counts.dropped += 1
+            return
+        self.record(fr)
+        if on_frame is not None:
+            on_frame(i, scan, fr)
+        bar.update(i + 1, f"{fr.scan.timings.total_s * MS_PER_S:6.1f} ms")
+
+    def next_scan(self, i: int) -> Any:
+        """Scan i without non-finite points; None (counted as skipped, with a warning) when it
+        cannot be read or does not come after the previous one."""
+        try:
+            scan = self.dataset.scan(i)
+        except (ValueError, OSError) as e:
+            self.counts.skipped += 1
+            _warn(f"skipping {self.dataset.scan_source(i)}: {e}")
+            return None
+        if self.last_stamp is not None and scan.end_stamp_ns <= self.last_stamp:
+            self.counts.skipped += 1
+            _warn(f"skipping {self.dataset.scan_source(i)}: its stamp {scan.end_stamp_ns} ns is not after the "
+                  f"previous scan's {self.last_stamp} ns (time going backwards)")
+            return None
+        removed = scan.remove_non_finite()
+        if removed:
+            _warn(f"{self.dataset.scan_source(i)}: dropped {removed} points with NaN/Inf coordinates or times")
+        return scan
+
+    def write_odometry(self) -> None:
+        """The 100 Hz odometry produced since the last call (LIO only)."""
+        if self.odom_tum is not None:
+            for stamp, pose in self.odo.take_odometry():
+                self.odom_tum.append(stamp, pose)
+
+    def record(self, fr: Any) -> None:
+        """The poses and counts of a processed frame."""
+        r = fr.scan
+        self.lidar_tum.append(r.stamp_ns, r.pose)
+        self.body_tum.append(r.stamp_ns, fr.body_pose)
+        self.lidar_poses.push_back(r.stamp_ns, r.pose)
+        self.counts.totals_ms.append(r.timings.total_s * MS_PER_S)
+        self.counts.registered += int(r.registered)
+        self.counts.converged += int(r.registered and r.converged)
+        self.counts.dropped += int(bool(fr.drop_reason))
+
+    def export_kitti(self) -> None:
+        """LiDAR poses relative to the first, KITTI 3x4."""
+        if len(self.lidar_poses) == 0:
+            return
+        first_inv = self.lidar_poses[0][1].inverse()
+        relative = farlio.Trajectory()
+        for k in range(len(self.lidar_poses)):
+            stamp, pose = self.lidar_poses[k]
+            relative.push_back(stamp, first_inv * pose)
+        _core.io.write_kitti(self.out_dir / SCANS_LIDAR_KITTI, relative)
+
+    def save_map(self) -> None:
+        submap = farlio.Scan(self.odo.map_points())
+        _core.io.write_ply(self.out_dir / MAP_PLY, submap)
+        _core.io.write_pcd(self.out_dir / MAP_PCD, submap)
+
+    def summarise(self) -> dict[str, Any]:
+        c, totals = self.counts, self.counts.totals_ms
+        summary = {
+            "dataset": str(self.dataset.path),
+            "mode": "lidar-inertial" if self.odo.inertial else "lidar-only",
+            "frames": self.frames,
+            "processed": len(totals),
+            "skipped": c.skipped,
+            "dropped": c.dropped,
+            "registered": c.registered,
+            "converged_fraction": c.converged / c.registered if c.registered else float("nan"),
+            "latency_ms": {"median": _percentile(totals, MEDIAN_PERCENTILE),
+                           "p99": _percentile(totals, TAIL_PERCENTILE),
+                           "max": max(totals) if totals else float("nan"),
+                           "mean": float(np.mean(totals)) if totals else float("nan")},
+            "wall_s": self.wall_s,
+            "rate_hz": len(totals) / self.wall_s if self.wall_s > 0 else float("nan"),
+            "device": self.odo.device,
+            "map_memory_bytes": self.odo.map_memory_bytes,
+            "threads": self.config.get("num_threads"),
+        }
+        stats = self.odo.fusion_stats
+        if stats is not None:
+            summary["fusion"] = _fusion_summary(stats)
+        return summary
+
+    def evaluate(self, summary: dict[str, Any], groundtruth: Path | None, plot: bool) -> None:
+        """Accuracy of the scan poses and of the 100 Hz odometry against the ground truth, when there
+        is one: eval_scans/, eval_odometry/ and summary["accuracy"], summary["accuracy_odometry"]."""
+        from .evaluation import evaluate_files
+        if len(self.lidar_poses) < MIN_EVALUATED_POSES:
+            return
+        gt_scans = groundtruth
+        if gt_scans is None and (Path(self.dataset.path) / GROUNDTRUTH_SCANS_TUM).exists():
+            gt_scans = Path(self.dataset.path) / GROUNDTRUTH_SCANS_TUM
+        if gt_scans is None:
+            gt_scans = self.dataset.groundtruth()  # a dense ground truth (MulRan): interpolated at the scan stamps
+        if gt_scans is not None:
+            summary["accuracy"] = evaluate_files(self.out_dir / SCANS_BODY_TUM, Path(gt_scans),
+                                                 self.out_dir / EVAL_SCANS_DIR, plot=plot)
+        gt_dense = groundtruth or self.dataset.groundtruth()
+        if gt_dense is not None and (self.out_dir / ODOMETRY_TUM).exists():
+            summary["accuracy_odometry"] = evaluate_files(self.out_dir / ODOMETRY_TUM, Path(gt_dense),
+                                                          self.out_dir / EVAL_ODOMETRY_DIR, plot=plot)
+
+    def plot(self, summary: dict[str, Any]) -> None:
+        """trajectory.png and latency.png, when a frame was processed."""
+        if self.counts.totals_ms:
+            from .plots import plot_run
+            plot_run(self.out_dir, summary.get("accuracy", {}).get("groundtruth_file"))
+
+    def write_summary(self, summary: dict[str, Any]) -> None:
+        """config.yaml with the effective parameters (the voxel size is fixed at the first scan) and
+        summary.json."""
+        effective = self.odo.effective_config
+        (self.out_dir / CONFIG_YAML).write_text(config_to_yaml(effective))
+        summary["voxel_size_m"] = float(effective.get("map.voxel_size_m"))
+        (self.out_dir / SUMMARY_JSON).write_text(json.dumps(summary, indent=2, default=_json_default))
+
+
+def _fusion_summary(stats: Any) -> dict[str, Any]:
+    """The fusion's counters for summary.json; warns about an accelerometer in g and IMU gaps."""
+    if stats.accel_in_g:
+        _warn(stats.accel_unit_message)
+    if stats.imu_gaps:
+        _warn(f"{stats.imu_gaps} IMU gap(s): no sample for longer than fusion.imu_gap_limit_s "
+              "(the last input was held)")
+    return {"lidar_groups_accepted": stats.lidar_groups_accepted,
+            "lidar_groups_rejected": stats.lidar_groups_rejected,
+            "reinitializations": stats.reinitializations, "imu_gaps": stats.imu_gaps,
+            "imu_samples_dropped": stats.imu_samples_dropped, "accel_in_g": stats.accel_in_g,
+            "gyro_bias_rad_s": list(stats.gyro_bias_rad_s)}
 
 
 def _json_default(o: Any) -> Any:

@@ -200,5 +200,6 @@ TEST(Sequence, BadFoldersThrow) {
   test::write_raw(d / "calib.yaml",
                   "T_imu_lidar:\n  - [1, 0, 0, 0]\n  - [0, 1, 0, 0]\n  - [0, 0, 1, 0]\n  - [0, 0, 0, 1]\nextra: {a: 1}\n");
   SequenceReader ok(d);  // extra keys are ignored
-  EXPECT_EQ(ok.calibration().gravity_m_s2, kDefaultGravity_m_s2);
+  EXPECT_FALSE(ok.calibration().gravity_m_s2.has_value());
+  EXPECT_EQ(ok.calibration().gravity_or_default(), kDefaultGravity_m_s2);
 }

@@ -117,3 +117,63 @@ TEST(TrajectoryWriter, FlushesEveryPose) {
   EXPECT_EQ(w.size(), tr.size());
   expect_same(tr, read_tum(p), true);
 }
+
+TEST(Stamps, SecondsALineExactlyWithCommentsAndCommas) {
+  TempDir tmp;
+  const auto p = tmp.path() / "times.txt";
+  test::write_raw(p, "# seconds\n1700000000.123456789\n\n  1700000000.2 extra\n1.036400e-01\n0.5,ouster\n");
+  EXPECT_EQ(read_stamps(p), (std::vector<std::int64_t>{1'700'000'000'123'456'789, 1'700'000'000'200'000'000,
+                                                       103'640'000, 500'000'000}));
+  test::write_raw(p, "0.1\n0.2\nabc\n");
+  test::expect_input_error([&] { (void)read_stamps(p); }, p, "times.txt:3: 'abc'");
+  test::write_raw(p, "# only a comment\n\n");
+  test::expect_input_error([&] { (void)read_stamps(p); }, p, "no stamps");
+  const auto none = tmp.path() / "none.txt";
+  test::expect_input_error([&] { (void)read_stamps(none); }, none, "no such file");
+}
+
+TEST(TrajectoryFile, FormatNamesAndDetection) {
+  EXPECT_EQ(parse_trajectory_format("auto"), TrajectoryFormat::kAuto);
+  EXPECT_EQ(parse_trajectory_format("tum"), TrajectoryFormat::kTum);
+  EXPECT_EQ(parse_trajectory_format("kitti"), TrajectoryFormat::kKitti);
+  EXPECT_FALSE(parse_trajectory_format("TUM"));
+  EXPECT_FALSE(parse_trajectory_format("csv"));
+
+  TempDir tmp;
+  const auto tum = tmp.path() / "a.tum";
+  const auto kitti = tmp.path() / "a.txt";
+  write_tum(tum, random_trajectory(3, 4, 1));
+  write_kitti(kitti, random_trajectory(3, 4, 1));
+  EXPECT_EQ(detect_trajectory_format(tum), TrajectoryFormat::kTum);
+  EXPECT_EQ(detect_trajectory_format(kitti), TrajectoryFormat::kKitti);
+  const auto odd = tmp.path() / "odd.txt";
+  test::write_raw(odd, "# comment\n1 2 3 4 5 6 7\n");
+  test::expect_input_error([&] { (void)detect_trajectory_format(odd); }, odd, "odd.txt:2: 7 values is neither TUM");
+  test::write_raw(odd, "\n# nothing\n");
+  test::expect_input_error([&] { (void)detect_trajectory_format(odd); }, odd, "no poses");
+  test::expect_input_error([&] { (void)read_trajectory(odd); }, odd, "no poses");
+}
+
+TEST(TrajectoryFile, ReadsEitherFormatWithItsStamps) {
+  TempDir tmp;
+  const auto tr = random_trajectory(20, 5, 1'700'000'000'000'000'007);
+  const auto tum = tmp.path() / "a.tum";
+  const auto kitti = tmp.path() / "a.txt";
+  const auto times = tmp.path() / "times.txt";
+  write_tum(tum, tr);
+  write_kitti(kitti, tr);
+  std::string text;
+  for (const auto& p : tr) text += format_seconds_from_ns(p.stamp_ns) + "\n";
+  test::write_raw(times, text);
+
+  expect_same(tr, read_trajectory(tum), true);
+  expect_same(tr, read_trajectory(tum, TrajectoryFormat::kTum, times), true);  // TUM ignores the times
+  expect_same(tr, read_trajectory(kitti, TrajectoryFormat::kAuto, times), true);
+  const Trajectory plain = read_trajectory(kitti, TrajectoryFormat::kKitti);
+  expect_same(tr, plain, false);
+  EXPECT_EQ(plain[3].stamp_ns, 3 * kKittiDefaultPeriodNs);
+  test::expect_input_error([&] { (void)read_trajectory(kitti, TrajectoryFormat::kTum); }, kitti, "a.txt:1");
+  test::write_raw(times, "0.1\n0.2\n");
+  test::expect_input_error([&] { (void)read_trajectory(kitti, TrajectoryFormat::kAuto, times); }, kitti,
+                           "20 poses but 2 stamps");
+}

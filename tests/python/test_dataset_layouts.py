@@ -13,6 +13,7 @@ import pytest
 core = pytest.importorskip("farlio._core")
 
 import farlio  # noqa: E402
+from farlio._core import NS_PER_S  # noqa: E402
 from farlio.datasets import detect_format, open_dataset  # noqa: E402
 from farlio.datasets.kitti_raw import EARTH_RADIUS_M, OXTS_COLUMNS, parse_kitti_stamp  # noqa: E402
 from farlio.runner import replay_options, run_dataset  # noqa: E402
@@ -29,7 +30,6 @@ OXTS_ACCEL, OXTS_GYRO = 11, 17   # first column of ax ay az and of wx wy wz
 ORIGIN_LAT_DEG, ORIGIN_LON_DEG, ORIGIN_ALT_M = 49.0, 8.4, 110.0
 #: OXTS positions go through degrees of latitude/longitude and back
 OXTS_POSE_TOLERANCE_M = 1e-6
-NS_PER_S = 1_000_000_000
 
 
 class WithoutTimes:
@@ -186,3 +186,18 @@ def test_mulran_missing_scan_files_are_reported(sequence, tmp_path):
     ds = open_dataset(root)
     assert len(ds) == len(folder) - 1
     assert any("1 Ouster stamps without a file" in w and victim.stem in w for w in ds.warnings())
+
+
+
+def test_kitti_odometry_times_convert_exactly(tmp_path):
+    """times.txt seconds become exact integer ns, also for Unix times that a float64 cannot hold to
+    the nanosecond (the dataloader shifts them by one default period)."""
+    from farlio.datasets.folders import DEFAULT_PERIOD_NS
+    times_s = ["1700000000.123456789", "1700000000.223456791"]
+    (tmp_path / "velodyne").mkdir()
+    for k in range(len(times_s)):
+        core.io.write_kitti_bin(str(tmp_path / "velodyne" / f"{k:06d}.bin"), farlio.Scan(np.ones((4, 3), np.float32)))
+    (tmp_path / "times.txt").write_text("\n".join(times_s) + "\n")
+    ds = open_dataset(tmp_path, "kitti")
+    expected = [int(t.replace(".", "")) + DEFAULT_PERIOD_NS for t in times_s]
+    assert [ds.scan(k).end_stamp_ns for k in range(len(times_s))] == expected

@@ -85,3 +85,28 @@ def test_sequence_round_trip(tmp_path: Path) -> None:
     assert reader.groundtruth() is None
     with pytest.raises(core.InputError, match="lidar"):
         io.SequenceReader(tmp_path)
+
+
+def test_ns_per_s_is_one_integer_for_every_module() -> None:
+    from farlio.datasets import kitti_raw, pointcloud2
+    assert core.NS_PER_S == 1_000_000_000 and isinstance(core.NS_PER_S, int)
+    assert pointcloud2.NS_PER_S is core.NS_PER_S and kitti_raw.NS_PER_S is core.NS_PER_S
+
+
+def test_times_files_and_trajectories_by_format(tmp_path: Path) -> None:
+    (tmp_path / "times.txt").write_text("# s\n1700000000.000000001\n1700000000.100000001, extra\n")
+    assert io.read_stamps(tmp_path / "times.txt") == [1_700_000_000_000_000_001, 1_700_000_000_100_000_001]
+    traj = core.Trajectory()
+    for stamp in io.read_stamps(tmp_path / "times.txt"):
+        traj.push_back(stamp, core.SE3.exp(np.array([stamp % 7, 0.0, 0.0, 0.0, 0.0, 0.1])))
+    io.write_kitti(tmp_path / "poses.txt", traj)
+    io.write_tum(tmp_path / "poses.tum", traj)
+    for path, times in ((tmp_path / "poses.txt", tmp_path / "times.txt"), (tmp_path / "poses.tum", None)):
+        back = io.read_trajectory(path, "auto", times)
+        np.testing.assert_array_equal(back.stamps_ns, traj.stamps_ns)
+    assert io.read_trajectory(tmp_path / "poses.txt").stamps_ns[1] == 100_000_000
+    with pytest.raises(ValueError, match="unknown trajectory format 'csv'"):
+        io.read_trajectory(tmp_path / "poses.txt", "csv")
+    with pytest.raises(core.InputError, match="times.txt:2"):
+        (tmp_path / "times.txt").write_text("1.0\nnope\n")
+        io.read_stamps(tmp_path / "times.txt")

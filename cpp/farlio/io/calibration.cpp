@@ -4,18 +4,17 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
-#include <fstream>
-#include <stdexcept>
 #include <string>
 
 #include "farlio/core/error.hpp"
+#include "farlio/io/rigid_transform.hpp"
 #include "farlio/io/text_number.hpp"
 
 namespace farlio::io {
 namespace {
 
 constexpr int kMatrixSize = 4;
-constexpr double kRigidTolerance = 1e-4;  // max deviation of R^T R from I and of the last row
+constexpr const char* kExtrinsicKey = "T_imu_lidar";
 
 double scalar_value(const YAML::Node& node, const std::string& file, const std::string& key) {
   try {
@@ -27,24 +26,38 @@ double scalar_value(const YAML::Node& node, const std::string& file, const std::
   }
 }
 
-SE3 read_matrix(const YAML::Node& node, const std::string& file, const std::string& key) {
-  auto bad = [&](const std::string& what) { return InputError(file + ": key '" + key + "': " + what); };
-  if (!node.IsSequence() || node.size() != kMatrixSize) throw bad("expected a 4x4 matrix as a list of 4 rows");
+/// A rigid transform written as a 4x4 row-major nested list under `key`.
+SE3 extrinsic_value(const YAML::Node& node, const std::string& file, const std::string& key) {
+  const std::string what = file + ": key '" + key + "'";
+  if (!node.IsSequence() || node.size() != kMatrixSize) {
+    throw InputError(what + ": expected a 4x4 matrix as a list of 4 rows");
+  }
   Mat4d m;
   for (int r = 0; r < kMatrixSize; ++r) {
     const YAML::Node row = node[static_cast<std::size_t>(r)];
-    if (!row.IsSequence() || row.size() != kMatrixSize) throw bad("row " + std::to_string(r) + " does not hold 4 numbers");
+    if (!row.IsSequence() || row.size() != kMatrixSize) {
+      throw InputError(what + ": row " + std::to_string(r) + " does not hold 4 numbers");
+    }
     for (int c = 0; c < kMatrixSize; ++c) {
-      m(r, c) = scalar_value(row[static_cast<std::size_t>(c)], file, key + "[" + std::to_string(r) + "][" + std::to_string(c) + "]");
+      const std::string element = key + "[" + std::to_string(r) + "][" + std::to_string(c) + "]";
+      m(r, c) = scalar_value(row[static_cast<std::size_t>(c)], file, element);
     }
   }
-  const Eigen::RowVector4d last(0, 0, 0, 1);
-  if ((m.row(3) - last).cwiseAbs().maxCoeff() > kRigidTolerance) throw bad("last row is not [0, 0, 0, 1]");
-  const Mat3d R = m.topLeftCorner<3, 3>();
-  if ((R.transpose() * R - Mat3d::Identity()).cwiseAbs().maxCoeff() > kRigidTolerance || R.determinant() < 0) {
-    throw bad("the rotation block is not a rotation matrix");
+  return rigid_transform_from_matrix(m, what);
+}
+
+/// The mapping form of T_imu_lidar: LiDAR topic or frame id -> 4x4 matrix.
+std::map<std::string, SE3> extrinsics_by_name(const YAML::Node& node, const std::string& file) {
+  std::map<std::string, SE3> out;
+  for (const auto& entry : node) {
+    if (!entry.first.IsScalar()) {
+      throw InputError(file + ": key '" + kExtrinsicKey + "': an entry's name is not a LiDAR topic or frame id");
+    }
+    const std::string name = entry.first.Scalar();
+    out[name] = extrinsic_value(entry.second, file, std::string(kExtrinsicKey) + "[" + name + "]");
   }
-  return SE3::from_matrix(m);
+  if (out.empty()) throw InputError(file + ": key '" + kExtrinsicKey + "': the mapping has no entry");
+  return out;
 }
 
 double optional_rate(const YAML::Node& root, const char* section, const std::string& file) {
@@ -53,7 +66,58 @@ double optional_rate(const YAML::Node& root, const char* section, const std::str
   return scalar_value(s["rate_hz"], file, std::string(section) + ".rate_hz");
 }
 
+/// The rows of `pose`'s matrix as YAML flow lists, one per line, each line starting with `indent`.
+std::string matrix_text(const SE3& pose, const std::string& indent) {
+  const Mat4d m = pose.matrix();
+  std::string text;
+  for (int r = 0; r < kMatrixSize; ++r) {
+    text += indent + "- [";
+    for (int c = 0; c < kMatrixSize; ++c) {
+      if (c) text += ", ";
+      text += format_number(m(r, c));
+    }
+    text += "]\n";
+  }
+  return text;
+}
+
+/// `name` as a YAML double-quoted scalar (any topic or frame id survives the round trip).
+std::string quoted(const std::string& name) {
+  YAML::Emitter out;
+  out << YAML::DoubleQuoted << name;
+  return out.c_str();
+}
+
+std::string extrinsics_text(const Calibration& calib) {
+  std::string text = std::string(kExtrinsicKey) +
+                     ":  # 4x4 row-major, maps LiDAR-frame points into the IMU (body) frame";
+  if (calib.T_imu_lidar_by_name.empty()) return text + "\n" + matrix_text(calib.T_imu_lidar, "  ");
+  text += ", per LiDAR topic or frame id\n";
+  for (const auto& [name, pose] : calib.T_imu_lidar_by_name) {
+    text += "  " + quoted(name) + ":\n" + matrix_text(pose, "    ");
+  }
+  return text;
+}
+
+/// "'a' or 'b'" / "a, b": the names a lookup tried and the entries it had.
+std::string joined(const std::vector<std::string>& names, const std::string& separator, bool quote) {
+  std::string out;
+  for (const auto& n : names) out += (out.empty() ? "" : separator) + (quote ? "'" + n + "'" : n);
+  return out;
+}
+
 }  // namespace
+
+const SE3& Calibration::lidar_extrinsic(const std::vector<std::string>& names) const {
+  if (T_imu_lidar_by_name.empty()) return T_imu_lidar;
+  for (const auto& name : names) {
+    if (const auto it = T_imu_lidar_by_name.find(name); it != T_imu_lidar_by_name.end()) return it->second;
+  }
+  std::vector<std::string> entries;
+  for (const auto& entry : T_imu_lidar_by_name) entries.push_back(entry.first);
+  throw InputError(source.string() + ": " + kExtrinsicKey + " has no entry for " + joined(names, " or ", true) +
+                   " (entries: " + joined(entries, ", ", false) + ")");
+}
 
 Calibration read_calibration(const std::filesystem::path& path) {
   const std::string file = path.string();
@@ -66,9 +130,15 @@ Calibration read_calibration(const std::filesystem::path& path) {
     throw InputError(file + ": not valid YAML (" + e.what() + ")");
   }
   if (!root.IsMap()) throw InputError(file + ": expected a YAML mapping at the top level");
+  const YAML::Node extrinsic = root[kExtrinsicKey];
+  if (!extrinsic) throw InputError(file + ": missing key '" + kExtrinsicKey + "'");
   Calibration c;
-  if (!root["T_imu_lidar"]) throw InputError(file + ": missing key 'T_imu_lidar'");
-  c.T_imu_lidar = read_matrix(root["T_imu_lidar"], file, "T_imu_lidar");
+  c.source = path;
+  if (extrinsic.IsMap()) {
+    c.T_imu_lidar_by_name = extrinsics_by_name(extrinsic, file);
+  } else {
+    c.T_imu_lidar = extrinsic_value(extrinsic, file, kExtrinsicKey);
+  }
   if (root["gravity"]) c.gravity_m_s2 = scalar_value(root["gravity"], file, "gravity");
   c.imu_rate_hz = optional_rate(root, "imu", file);
   c.lidar_rate_hz = optional_rate(root, "lidar", file);
@@ -76,17 +146,8 @@ Calibration read_calibration(const std::filesystem::path& path) {
 }
 
 void write_calibration(const std::filesystem::path& path, const Calibration& calib) {
-  std::string text = "T_imu_lidar:  # 4x4 row-major, maps LiDAR-frame points into the IMU (body) frame\n";
-  const Mat4d m = calib.T_imu_lidar.matrix();
-  for (int r = 0; r < kMatrixSize; ++r) {
-    text += "  - [";
-    for (int c = 0; c < kMatrixSize; ++c) {
-      if (c) text += ", ";
-      text += format_number(m(r, c));
-    }
-    text += "]\n";
-  }
-  text += "gravity: " + format_number(calib.gravity_m_s2) + "\n";
+  std::string text = extrinsics_text(calib);
+  if (calib.gravity_m_s2) text += "gravity: " + format_number(*calib.gravity_m_s2) + "\n";
   if (calib.imu_rate_hz > 0) text += "imu:\n  rate_hz: " + format_number(calib.imu_rate_hz) + "\n";
   if (calib.lidar_rate_hz > 0) text += "lidar:\n  rate_hz: " + format_number(calib.lidar_rate_hz) + "\n";
   write_text_file(path, text);

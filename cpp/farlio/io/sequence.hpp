@@ -35,7 +35,8 @@ class SequenceReader {
 
   [[nodiscard]] bool has_imu() const { return has_imu_; }
   [[nodiscard]] const std::vector<ImuSample>& imu() const { return imu_; }
-  /// calib.yaml; the defaults (identity extrinsic) when the folder has none.
+  /// calib.yaml (one 4x4 T_imu_lidar; the mapping form is an error); the defaults (identity
+  /// extrinsic, gravity not stated) when the folder has none.
   [[nodiscard]] const Calibration& calibration() const { return calib_; }
   [[nodiscard]] bool has_calibration() const { return has_calib_; }
 

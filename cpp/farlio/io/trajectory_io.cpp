@@ -5,6 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 
 #include "farlio/core/error.hpp"
 #include "farlio/io/text_number.hpp"
@@ -17,6 +18,7 @@ constexpr std::size_t kKittiValues = 12;  // 3x4 row-major
 constexpr int kKittiRows = 3;
 constexpr int kKittiCols = 4;
 constexpr double kMinQuaternionNorm = 1e-6;
+constexpr char kFieldComma = ',';  // times files may be comma separated
 constexpr const char* kTumHeader = "# t x y z qx qy qz qw (t in seconds)\n";
 
 std::string tum_line(std::int64_t stamp_ns, const SE3& pose) {
@@ -40,7 +42,8 @@ std::ifstream open_for_reading(const std::filesystem::path& path) {
 }
 
 
-/// Calls on_values(line_no, tokens) for every non-blank, non-comment line.
+/// Calls on_values(line_no, tokens) for every non-blank, non-comment line; stops early when
+/// on_values returns false (if it returns a bool).
 template <class F>
 void for_each_data_line(const std::filesystem::path& path, F&& on_values) {
   std::ifstream in = open_for_reading(path);
@@ -50,7 +53,11 @@ void for_each_data_line(const std::filesystem::path& path, F&& on_values) {
     ++line_no;
     const auto t = trim(line);
     if (t.empty() || t.front() == '#') continue;
-    on_values(line_no, split_whitespace(t));
+    if constexpr (std::is_same_v<decltype(on_values(line_no, split_whitespace(t))), bool>) {
+      if (!on_values(line_no, split_whitespace(t))) return;
+    } else {
+      on_values(line_no, split_whitespace(t));
+    }
   }
 }
 
@@ -111,6 +118,48 @@ Trajectory read_kitti(const std::filesystem::path& path, const std::vector<std::
     traj.push_back(stamp, poses[i]);
   }
   return traj;
+}
+
+std::vector<std::int64_t> read_stamps(const std::filesystem::path& path) {
+  std::vector<std::int64_t> stamps;
+  for_each_data_line(path, [&](std::size_t line_no, const std::vector<std::string_view>& tok) {
+    const std::string_view first = tok[0].substr(0, tok[0].find(kFieldComma));
+    const auto stamp = parse_seconds_to_ns(first);
+    if (!stamp) bad_line(path, line_no, "'" + std::string(first) + "' is not a number of seconds");
+    stamps.push_back(*stamp);
+  });
+  if (stamps.empty()) throw InputError(path.string() + ": no stamps");
+  return stamps;
+}
+
+std::optional<TrajectoryFormat> parse_trajectory_format(std::string_view name) {
+  for (const auto& [n, format] : kTrajectoryFormatNames) {
+    if (n == name) return format;
+  }
+  return std::nullopt;
+}
+
+TrajectoryFormat detect_trajectory_format(const std::filesystem::path& path) {
+  std::optional<TrajectoryFormat> format;
+  for_each_data_line(path, [&](std::size_t line_no, const std::vector<std::string_view>& tok) {
+    if (tok.size() != kTumValues && tok.size() != kKittiValues) {
+      bad_line(path, line_no, std::to_string(tok.size()) + " values is neither TUM (" + std::to_string(kTumValues) +
+                                  ") nor KITTI (" + std::to_string(kKittiValues) + ")");
+    }
+    format = tok.size() == kTumValues ? TrajectoryFormat::kTum : TrajectoryFormat::kKitti;
+    return false;  // the first data line decides
+  });
+  if (!format) throw InputError(path.string() + ": no poses");
+  return *format;
+}
+
+Trajectory read_trajectory(const std::filesystem::path& path, TrajectoryFormat format,
+                           const std::optional<std::filesystem::path>& kitti_times) {
+  if (format == TrajectoryFormat::kAuto) format = detect_trajectory_format(path);
+  if (format == TrajectoryFormat::kTum) return read_tum(path);
+  if (!kitti_times) return read_kitti(path);
+  const std::vector<std::int64_t> stamps = read_stamps(*kitti_times);
+  return read_kitti(path, &stamps);
 }
 
 void write_kitti(const std::filesystem::path& path, const Trajectory& trajectory) {

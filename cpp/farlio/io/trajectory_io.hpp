@@ -3,10 +3,15 @@
 //   TUM:   "t x y z qx qy qz qw" per line, t in seconds (written with 9 decimals and converted
 //          to and from integer ns exactly); '#' comments and blank lines are allowed.
 //   KITTI: 12 numbers per line, the 3x4 row-major [R | t]; no stamps in the file.
+//   times: seconds a line (a KITTI times.txt, scan stamps), converted to integer ns exactly.
 // Bad lines throw InputError naming the file and line; unwritable files std::runtime_error.
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <optional>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 #include "farlio/core/trajectory.hpp"
@@ -25,6 +30,29 @@ void write_tum(const std::filesystem::path& path, const Trajectory& trajectory);
                                     const std::vector<std::int64_t>* stamps_ns = nullptr);
 /// Writes the poses only (KITTI has no stamps).
 void write_kitti(const std::filesystem::path& path, const Trajectory& trajectory);
+
+/// A times file: the first field of every line that is not blank or a '#' comment (fields are
+/// separated by whitespace or commas), seconds converted to ns by parse_seconds_to_ns (exact for
+/// plain decimals). InputError naming file:line for a field that is not a number of seconds, or
+/// naming the file when it holds no stamp.
+[[nodiscard]] std::vector<std::int64_t> read_stamps(const std::filesystem::path& path);
+
+enum class TrajectoryFormat { kAuto, kTum, kKitti };
+/// The names of the formats, as the command line and Python take them.
+inline constexpr std::array<std::pair<std::string_view, TrajectoryFormat>, 3> kTrajectoryFormatNames{{
+    {"auto", TrajectoryFormat::kAuto}, {"tum", TrajectoryFormat::kTum}, {"kitti", TrajectoryFormat::kKitti}}};
+/// The format called `name` (kTrajectoryFormatNames); nullopt for any other name.
+[[nodiscard]] std::optional<TrajectoryFormat> parse_trajectory_format(std::string_view name);
+
+/// kTum or kKitti by the number of values on the first data line (8 or 12); InputError naming
+/// the file (and line) when it is neither or the file holds no pose.
+[[nodiscard]] TrajectoryFormat detect_trajectory_format(const std::filesystem::path& path);
+
+/// A TUM or KITTI file (kAuto: detect_trajectory_format). KITTI poses are stamped from
+/// `kitti_times` (read_stamps) when given, else i * kKittiDefaultPeriodNs; TUM files ignore it.
+[[nodiscard]] Trajectory read_trajectory(const std::filesystem::path& path,
+                                         TrajectoryFormat format = TrajectoryFormat::kAuto,
+                                         const std::optional<std::filesystem::path>& kitti_times = std::nullopt);
 
 /// Writes a TUM file pose by pose, flushing each line, so a crash loses nothing written.
 class TrajectoryWriter {

@@ -3,7 +3,8 @@
 
 The calibration file (`--calib`) is the sequence folder's calib.yaml (`T_imu_lidar`: 4x4 row-major,
 maps LiDAR points into the IMU/body frame; `gravity`), where for several LiDARs `T_imu_lidar` may
-be a mapping from topic (or frame id) to 4x4 matrix.
+be a mapping from topic (or frame id) to 4x4 matrix. It is read, and matrices are checked to be
+rigid, by the C++ reader (farlio._core.io, docs/io.md).
 """
 from __future__ import annotations
 
@@ -11,23 +12,19 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 
 import farlio
+from farlio import _core
 
-#: how far from a rigid transform a calibration matrix may be (rotation orthonormality, last row)
-RIGID_TOLERANCE = 1e-4
+MATRIX_SHAPE = (4, 4)
 
 
 def se3_from_matrix(m: Any, where: str) -> farlio.SE3:
+    """The rigid transform of a 4x4 matrix; ValueError naming `where` if it is not one."""
     a = np.asarray(m, dtype=np.float64)
-    if a.shape != (4, 4):
+    if a.shape != MATRIX_SHAPE:
         raise ValueError(f"{where}: expected a 4x4 matrix, got shape {a.shape}")
-    r = a[:3, :3]
-    if (np.abs(r @ r.T - np.eye(3)).max() > RIGID_TOLERANCE or
-            np.abs(a[3] - [0, 0, 0, 1]).max() > RIGID_TOLERANCE or np.linalg.det(r) < 0):
-        raise ValueError(f"{where}: not a rigid transform (rotation not orthonormal or last row not 0 0 0 1)")
-    return farlio.SE3.from_matrix(a)
+    return _core.io.rigid_transform_from_matrix(a, where)
 
 
 def se3_from_quaternion(t: Any, q_xyzw: Any) -> farlio.SE3:
@@ -48,28 +45,13 @@ class CalibFile:
 
     def __init__(self, path: Path):
         self.path = Path(path)
-        try:
-            doc = yaml.safe_load(self.path.read_text())
-        except yaml.YAMLError as e:
-            raise ValueError(f"{self.path}: not YAML: {e}") from None
-        if not isinstance(doc, dict) or "T_imu_lidar" not in doc:
-            raise ValueError(f"{self.path}: expected a key 'T_imu_lidar' (4x4 row-major, or a mapping from "
-                             f"LiDAR topic/frame to 4x4)")
-        value = doc["T_imu_lidar"]
-        if isinstance(value, dict):
-            self._by_name = {str(k): se3_from_matrix(v, f"{self.path}: T_imu_lidar[{k}]") for k, v in value.items()}
-            self._single = None
-        else:
-            self._by_name = {}
-            self._single = se3_from_matrix(value, f"{self.path}: T_imu_lidar")
-        self.gravity_m_s2 = float(doc["gravity"]) if "gravity" in doc else None
+        self._calib = _core.io.read_calibration(self.path)
+
+    @property
+    def gravity_m_s2(self) -> float | None:
+        """The file's gravity; None when it does not state one."""
+        return self._calib.gravity_m_s2
 
     def T_imu_lidar(self, *names: str) -> farlio.SE3:
         """The extrinsic of the LiDAR known by any of `names` (topic, frame id)."""
-        if self._single is not None:
-            return self._single
-        for n in names:
-            if n in self._by_name:
-                return self._by_name[n]
-        raise ValueError(f"{self.path}: T_imu_lidar has no entry for {' or '.join(repr(n) for n in names)} "
-                         f"(entries: {', '.join(self._by_name)})")
+        return self._calib.lidar_extrinsic(list(names))

@@ -50,7 +50,7 @@ class SequenceFolder(Dataset):
         return self._reader.calibration().T_imu_lidar
 
     def gravity_m_s2(self) -> float:
-        return self._reader.calibration().gravity_m_s2
+        return self._reader.calibration().gravity_or_default()
 
     def groundtruth(self) -> Path | None:
         p = self.path / "groundtruth.tum"
@@ -95,14 +95,13 @@ class KittiOdometry(_FilesWithStamps):
             raise ValueError(f"{self.path / 'velodyne'}: no .bin scans")
         times = self.path / "times.txt"
         if times.exists():
-            stamps = [round(float(line) * 1e9) for line in times.read_text().split()]
+            stamps = _core.io.read_stamps(times)
             if len(stamps) != len(self._files):
                 raise ValueError(f"{times}: {len(stamps)} stamps for {len(self._files)} scans in velodyne/")
             # KITTI stamps can start at 0: shift so that the first scan has a positive start
             self._stamps = [s + DEFAULT_PERIOD_NS for s in stamps]
         else:
             self._stamps = [(i + 1) * DEFAULT_PERIOD_NS for i in range(len(self._files))]
-
 
 
 class PointCloudFolder(_FilesWithStamps):

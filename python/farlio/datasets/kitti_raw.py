@@ -21,12 +21,12 @@ import numpy as np
 
 import farlio
 from farlio import _core
+from farlio._core import NS_PER_S
 
 from .base import Dataset, LoadOptions
 from .calib import CalibFile, se3_from_matrix
 from .folders import DEFAULT_PERIOD_NS, _FilesWithStamps
 
-NS_PER_S = 1_000_000_000
 CALIB_FILE = "calib_imu_to_velo.txt"
 #: columns of an OXTS line (KITTI devkit dataformat.txt)
 OXTS_ACCEL_COLUMNS = slice(11, 14)   # ax ay az

@@ -20,6 +20,7 @@ from typing import Any, Iterator
 import numpy as np
 
 import farlio
+from farlio._core import NS_PER_S
 
 from .base import Dataset, LoadOptions
 from .rosbag import OUSTER_PACKET_TYPES, bag_messages, describe_topics, is_bag_path, open_bag
@@ -27,7 +28,6 @@ from .rosbag import OUSTER_PACKET_TYPES, bag_messages, describe_topics, is_bag_p
 PCAP_SUFFIX = ".pcap"
 OSF_SUFFIX = ".osf"
 MM_PER_M = 1000.0
-NS_PER_S = 1_000_000_000
 #: measurement-block status bit that marks a valid column
 COLUMN_VALID = 0x1
 LIDAR_TOPIC_PART, IMU_TOPIC_PART, METADATA_TOPIC_PART = "lidar_packets", "imu_packets", "metadata"

@@ -26,13 +26,15 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from farlio._core import NS_PER_S
+
 #: PointField datatype codes (sensor_msgs/PointField) -> numpy type
 POINTFIELD_TYPES = {1: "i1", 2: "u1", 3: "i2", 4: "u2", 5: "i4", 6: "u4", 7: "f4", 8: "f8"}
 #: names of the per-point time field, first found wins
 TIME_FIELDS = ("t", "time", "timestamp", "offset_time", "time_stamp", "time_offset", "ts")
 INTENSITY_FIELDS = ("intensity", "reflectivity", "i")
 #: nanoseconds per unit of a time field
-NS_PER_UNIT = {"s": 1_000_000_000, "ms": 1_000_000, "us": 1_000, "ns": 1}
+NS_PER_UNIT = {"s": NS_PER_S, "ms": 1_000_000, "us": 1_000, "ns": 1}
 TIME_UNITS = ("auto", *NS_PER_UNIT)
 HEADER_STAMPS = ("auto", "start", "end")
 #: time values (in s) above this are absolute (Unix) times, not offsets (1e6 s is 11.6 days)
@@ -41,7 +43,6 @@ ABSOLUTE_TIME_MIN_S = 1e6
 MAX_SCAN_SPAN_S = 1.0
 #: offsets within this of 0 still count as "<= 0" when deciding that the header is the scan end
 HEADER_END_TOLERANCE_S = 1e-6
-NS_PER_S = 1_000_000_000
 
 
 class CloudError(ValueError):

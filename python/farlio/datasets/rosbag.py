@@ -20,10 +20,11 @@ from typing import Any, Iterator
 import numpy as np
 
 import farlio
+from farlio._core import NS_PER_S
 
 from .base import Dataset, LoadOptions
 from .calib import CalibFile, se3_from_quaternion
-from .pointcloud2 import (MAX_SCAN_SPAN_S, NS_PER_S, TIME_FIELDS, Cloud, CloudError, decode, field_names, stamp_ns,
+from .pointcloud2 import (MAX_SCAN_SPAN_S, TIME_FIELDS, Cloud, CloudError, decode, field_names, stamp_ns,
                           time_field_of)
 
 POINTCLOUD2 = "sensor_msgs/msg/PointCloud2"

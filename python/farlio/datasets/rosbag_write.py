@@ -13,7 +13,7 @@ import numpy as np
 
 import farlio
 
-from .pointcloud2 import NS_PER_S
+from farlio._core import NS_PER_S
 
 STORAGES = ("ros1", "sqlite3", "mcap")
 #: sensor_msgs/PointField datatype codes
