@@ -183,7 +183,7 @@ void bind_core(nb::module_& m) {
       .def("is_time_ordered", &Trajectory::is_time_ordered)
       .def("__repr__", &trajectory_repr);
 
-  m.attr("NS_PER_S") = static_cast<std::int64_t>(kNsPerS);  // stamps are integer ns
+  m.attr("NS_PER_S") = kNsPerSecond;  // stamps are integer ns
   m.def("cuda_compiled", &cuda_compiled, "True if this build contains the CUDA backend.");
   m.def("cuda_device_count", &cuda_device_count, "Number of usable CUDA devices.");
 }

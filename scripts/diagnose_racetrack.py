@@ -14,6 +14,7 @@ import numpy as np
 
 import farlio
 from farlio import _core
+from farlio._core import NS_PER_S
 
 FIRST_MOVING_SCAN = 40  # the profile stands still for 2 s (40 scans at 20 Hz)
 EVERY = 5
@@ -37,8 +38,8 @@ def main() -> None:
     def undistorted(i: int) -> farlio.Scan:
         s = reader.read_scan(i)
         pts = np.asarray(s.points, dtype=np.float64)
-        t = s.start_stamp_ns * 1e-9 + np.asarray(s.time_s, dtype=np.float64)  # float64: stamps ~1.7e9 s
-        shift_world = position_at(t) - position_at(np.array([s.end_stamp_ns * 1e-9]))
+        t = s.start_stamp_ns / NS_PER_S + np.asarray(s.time_s, dtype=np.float64)  # float64: stamps ~1.7e9 s
+        shift_world = position_at(t) - position_at(np.array([s.end_stamp_ns / NS_PER_S]))
         body = pts @ T[:3, :3].T + T[:3, 3] + shift_world @ G[i][:3, :3]
         return farlio.Scan(((body - T[:3, 3]) @ T[:3, :3]).astype(np.float32))
 

@@ -36,7 +36,6 @@ struct ChannelMap {
 /// Builds a scan of `n` points; get(i, field_index) returns point i's value of a field (element 0).
 template <class Get>
 Scan assemble_scan(std::size_t n, const ChannelMap& m, Get&& get) {
-  constexpr double kSecondsPerNs = 1e-9;
   Scan s;
   s.points.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
@@ -49,8 +48,8 @@ Scan assemble_scan(std::size_t n, const ChannelMap& m, Get&& get) {
   }
   if (m.time) {
     s.time_s.resize(n);
-    const double scale = m.time_in_ns ? kSecondsPerNs : 1.0;
-    for (std::size_t i = 0; i < n; ++i) s.time_s[i] = static_cast<float>(get(i, *m.time) * scale);
+    const double divisor = m.time_in_ns ? kNsPerS : 1.0;
+    for (std::size_t i = 0; i < n; ++i) s.time_s[i] = static_cast<float>(get(i, *m.time) / divisor);
   }
   if (m.sensor_id) {
     s.sensor_id.resize(n);

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "farlio/core/error.hpp"
+#include "farlio/core/time.hpp"
 #include "farlio/io/imu_csv.hpp"
 #include "farlio/io/sequence.hpp"
 #include "farlio/io/text_number.hpp"
@@ -11,8 +12,6 @@
 
 namespace farlio::io {
 namespace {
-
-constexpr double kNsPerSecond = 1e9;
 
 /// The file name without its point cloud extension(s): "123.pcd.gz" -> "123".
 std::string stem_of(const std::filesystem::path& p) {
@@ -33,7 +32,7 @@ std::optional<Trajectory> read_optional_tum(const std::filesystem::path& p) {
 std::int64_t max_time_ns(const Scan& s) {
   float max_t = 0.0f;
   for (float t : s.time_s) max_t = std::max(max_t, t);
-  return static_cast<std::int64_t>(std::llround(static_cast<double>(max_t) * kNsPerSecond));
+  return seconds_to_ns(static_cast<double>(max_t));
 }
 
 }  // namespace

@@ -5,13 +5,13 @@
 #include <cmath>
 #include <limits>
 
+#include "farlio/core/time.hpp"
+
 namespace farlio::io {
 namespace {
 
-constexpr std::int64_t kNsPerSecond = 1'000'000'000;
 constexpr int kNsDecimals = 9;
 constexpr std::size_t kNumberBufferBytes = 64;
-constexpr double kNsPerSecondD = 1e9;
 
 template <class T>
 std::string format_float_like(T v) {
@@ -77,7 +77,7 @@ std::optional<std::int64_t> parse_seconds_to_ns(std::string_view s) {
   constexpr std::size_t kMaxIntDigits = 10;  // int64 ns reach 9223372036 s
   if (!all_digits(int_part) || !all_digits(frac_part) || int_part.size() > kMaxIntDigits ||
       (int_part.empty() && frac_part.empty())) {
-    const double ns = *as_double * kNsPerSecondD;
+    const double ns = *as_double * kNsPerS;
     if (std::fabs(ns) >= static_cast<double>(std::numeric_limits<std::int64_t>::max())) return std::nullopt;
     return static_cast<std::int64_t>(std::llround(ns));
   }
