@@ -18,8 +18,8 @@ using namespace farlio;
 
 namespace {
 
-constexpr std::size_t kWarmupScans = 30;   // urban starts at rest: take scans while driving
-constexpr std::size_t kFrameScans = 60;    // scans cycled through by the whole-frame benchmark
+constexpr std::size_t kWarmupScans = 30;  // urban starts at rest: take scans while driving
+constexpr std::size_t kFrameScans = 60;   // scans cycled through by the whole-frame benchmark
 
 /// Generated urban scans, shared by all benchmarks (generated once).
 const std::vector<Scan>& urban_scans() {
@@ -38,7 +38,8 @@ const std::vector<Scan>& urban_scans() {
 std::vector<Eigen::Vector3f> downsampled(const Scan& scan, exec::CpuExecutor& ex) {
   Config cfg;
   const auto cropped = pipeline::crop_by_range(scan.points, cfg.preprocess);
-  const auto kept = pipeline::voxel_downsample(scan.points, cropped, static_cast<float>(map::point_spacing_m(cfg.map)), ex);
+  const auto kept =
+      pipeline::voxel_downsample(scan.points, cropped, static_cast<float>(map::point_spacing_m(cfg.map)), ex);
   std::vector<Eigen::Vector3f> out;
   for (auto i : kept) out.push_back(scan.points[static_cast<std::size_t>(i)]);
   return out;
@@ -71,8 +72,9 @@ struct MapFixture {
   map::VoxelMap map{VoxelMapConfig{}, ex};
   std::vector<Eigen::Vector3f> queries;
   explicit MapFixture(int threads) : ex(threads) {
-    for (int i = 0; i < 5; ++i) map.insert(downsampled(urban_scans()[static_cast<std::size_t>(i)], ex), Eigen::Vector3f::Zero(),
-                                           map::PointLimit::constant(40));
+    for (int i = 0; i < 5; ++i)
+      map.insert(downsampled(urban_scans()[static_cast<std::size_t>(i)], ex), Eigen::Vector3f::Zero(),
+                 map::PointLimit::constant(40));
     queries = downsampled(urban_scans()[5], ex);
   }
 };
@@ -114,7 +116,8 @@ void BM_GicpIteration(benchmark::State& state) {
   const auto src = registration::source_from_map(frame.view(), frame.voxel_capacity());
   const auto th = registration::Thresholds::from_sigma(1.0);
   for (auto _ : state) {
-    benchmark::DoNotOptimize(registration::build_linear_system(src, f.map.view(), SE3(), th, RegistrationConfig(), f.ex));
+    benchmark::DoNotOptimize(
+        registration::build_linear_system(src, f.map.view(), SE3(), th, RegistrationConfig(), f.ex));
   }
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(src.size()));
 }

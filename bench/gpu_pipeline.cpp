@@ -49,12 +49,18 @@ Options parse(int argc, char** argv) {
       if (i + 1 >= argc) throw std::invalid_argument(a + " needs a value");
       return std::string(argv[++i]);
     };
-    if (a == "--frames") o.frames = std::stoul(value());
-    else if (a == "--profile") o.profiles.push_back(value());
-    else if (a == "--device") o.device = parse_device(value(), "--device");
-    else if (a == "--no-cpu-compare") o.compare_cpu = false;
-    else if (a == "--repeats") o.repeats = std::stoi(value());
-    else throw std::invalid_argument("unknown option " + a + " (see the comment at the top of bench/gpu_pipeline.cpp)");
+    if (a == "--frames")
+      o.frames = std::stoul(value());
+    else if (a == "--profile")
+      o.profiles.push_back(value());
+    else if (a == "--device")
+      o.device = parse_device(value(), "--device");
+    else if (a == "--no-cpu-compare")
+      o.compare_cpu = false;
+    else if (a == "--repeats")
+      o.repeats = std::stoi(value());
+    else
+      throw std::invalid_argument("unknown option " + a + " (see the comment at the top of bench/gpu_pipeline.cpp)");
   }
   if (o.profiles.empty()) o.profiles = {"urban", "racetrack"};
   return o;
@@ -99,7 +105,8 @@ Run run(pipeline::ScanPipeline& p, const std::vector<Scan>& scans, double used_b
     const auto t0 = std::chrono::steady_clock::now();
     const auto f = p.process(s);
     r.total_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-    const double st[4] = {f.timings.preprocess_s, f.timings.covariance_s, f.timings.registration_s, f.timings.map_update_s};
+    const double st[4] = {f.timings.preprocess_s, f.timings.covariance_s, f.timings.registration_s,
+                          f.timings.map_update_s};
     for (int k = 0; k < 4; ++k) r.stage_ms[k].push_back(st[k] * kMsPerS);
     r.poses.push_back(f.pose);
     r.max_voxels = std::max(r.max_voxels, f.map_voxels);
@@ -132,9 +139,9 @@ int main(int argc, char** argv) {
   try {
     const Options o = parse(argc, argv);
     resolve_device(o.device);  // cuda without a GPU: the error before anything else
-    std::printf("%-10s %7s %6s %6s %9s %8s %8s | %8s %8s %8s %8s | %9s %9s | %9s %10s | %7s\n", "profile", "points", "device",
-                "frames", "median ms", "p99 ms", "max ms", "prep", "source", "gicp", "update", "prealloc", "used MiB",
-                "dt_max m", "dr_max deg", "voxels");
+    std::printf("%-10s %7s %6s %6s %9s %8s %8s | %8s %8s %8s %8s | %9s %9s | %9s %10s | %7s\n", "profile", "points",
+                "device", "frames", "median ms", "p99 ms", "max ms", "prep", "source", "gicp", "update", "prealloc",
+                "used MiB", "dt_max m", "dr_max deg", "voxels");
     for (const auto& profile : o.profiles) {
       const std::vector<Scan> scans = generate(profile, o.frames);
       double points = 0;
@@ -158,11 +165,12 @@ int main(int argc, char** argv) {
           dr = std::max(dr, d.angle_rad() * 180.0 / M_PI);
         }
       }
-      std::printf("%-10s %7.0f %6s %6zu %9.2f %8.2f %8.2f | %8.2f %8.2f %8.2f %8.2f | %9.1f %9.1f | %9.2e %10.2e | %7zu\n",
-                  profile.c_str(), points, device_name(p.backend().device()), scans.size(), quantile(r.total_ms, kMedian),
-                  quantile(r.total_ms, kP99), quantile(r.total_ms, 1.0), quantile(r.stage_ms[0], kMedian),
-                  quantile(r.stage_ms[1], kMedian), quantile(r.stage_ms[2], kMedian), quantile(r.stage_ms[3], kMedian),
-                  r.prealloc_bytes / kMiB, r.used_bytes / kMiB, dt, dr, r.max_voxels);
+      std::printf(
+          "%-10s %7.0f %6s %6zu %9.2f %8.2f %8.2f | %8.2f %8.2f %8.2f %8.2f | %9.1f %9.1f | %9.2e %10.2e | %7zu\n",
+          profile.c_str(), points, device_name(p.backend().device()), scans.size(), quantile(r.total_ms, kMedian),
+          quantile(r.total_ms, kP99), quantile(r.total_ms, 1.0), quantile(r.stage_ms[0], kMedian),
+          quantile(r.stage_ms[1], kMedian), quantile(r.stage_ms[2], kMedian), quantile(r.stage_ms[3], kMedian),
+          r.prealloc_bytes / kMiB, r.used_bytes / kMiB, dt, dr, r.max_voxels);
       std::printf("  stages: median ms, %s\n", r.device_timed ? "CUDA events" : "wall clock");
       print_bandwidth(p, o.repeats);
     }

@@ -16,9 +16,9 @@ nanobind::ndarray<nanobind::numpy, T> owned_array(std::vector<T> values, std::in
   return nanobind::ndarray<nanobind::numpy, T>(heap->data(), shape, owner);
 }
 
-void bind_core(nanobind::module_& m);  // core.cpp: Scan, ImuSample, SE3, Trajectory, Device
-void bind_io(nanobind::module_& m);    // io.cpp: file formats, sequence folder
-void bind_sim(nanobind::module_& m);   // sim.cpp: sequence generator
-void bind_eval(nanobind::module_& m);  // eval.cpp: APE, RPE, coverage
+void bind_core(nanobind::module_& m);      // core.cpp: Scan, ImuSample, SE3, Trajectory, Device
+void bind_io(nanobind::module_& m);        // io.cpp: file formats, sequence folder
+void bind_sim(nanobind::module_& m);       // sim.cpp: sequence generator
+void bind_eval(nanobind::module_& m);      // eval.cpp: APE, RPE, coverage
 void bind_pipeline(nanobind::module_& m);  // pipeline.cpp: Config, ScanPipeline, results
 }  // namespace farlio::python

@@ -7,12 +7,12 @@
 #include <nanobind/stl/vector.h>
 
 #include "bindings.hpp"
-#include "repr.hpp"
 #include "farlio/core/device.hpp"
 #include "farlio/core/se3.hpp"
 #include "farlio/core/time.hpp"
 #include "farlio/core/trajectory.hpp"
 #include "farlio/core/types.hpp"
+#include "repr.hpp"
 
 namespace nb = nanobind;
 using namespace nb::literals;
@@ -81,9 +81,8 @@ void bind_core(nb::module_& m) {
   nb::class_<Scan>(m, "Scan", "One LiDAR scan: float32 points with per-point times (s since scan start).")
       .def(
           "__init__",
-          [](Scan* s, const InPoints& points, std::optional<In1<float>> time_s,
-             std::optional<In1<float>> intensity, std::int64_t start_stamp_ns, std::int64_t end_stamp_ns,
-             std::optional<In1<std::uint8_t>> sensor_id) {
+          [](Scan* s, const InPoints& points, std::optional<In1<float>> time_s, std::optional<In1<float>> intensity,
+             std::int64_t start_stamp_ns, std::int64_t end_stamp_ns, std::optional<In1<std::uint8_t>> sensor_id) {
             new (s) Scan();
             set_points(*s, points);
             assign(s->time_s, time_s, s->size(), "time_s");
@@ -93,8 +92,8 @@ void bind_core(nb::module_& m) {
             s->end_stamp_ns = end_stamp_ns;
             s->validate("Scan");
           },
-          "points"_a, "time_s"_a = nb::none(), "intensity"_a = nb::none(), "start_stamp_ns"_a = 0,
-          "end_stamp_ns"_a = 0, "sensor_id"_a = nb::none())
+          "points"_a, "time_s"_a = nb::none(), "intensity"_a = nb::none(), "start_stamp_ns"_a = 0, "end_stamp_ns"_a = 0,
+          "sensor_id"_a = nb::none())
       .def_rw("start_stamp_ns", &Scan::start_stamp_ns)
       .def_rw("end_stamp_ns", &Scan::end_stamp_ns)
       .def_prop_ro(
@@ -159,24 +158,26 @@ void bind_core(nb::module_& m) {
              if (i >= t.size()) throw nb::index_error();
              return nb::make_tuple(t[i].stamp_ns, t[i].pose);
            })
-      .def_prop_ro("stamps_ns",
-                   [](const Trajectory& t) {
-                     std::vector<std::int64_t> v;
-                     for (const auto& p : t) v.push_back(p.stamp_ns);
-                     return owned_array(std::move(v), {t.size()});
-                   },
-                   nb::rv_policy::move, "(N,) int64 stamps in ns (a copy)")
-      .def("matrices",
-           [](const Trajectory& t) {
-             std::vector<double> v;
-             v.reserve(16 * t.size());
-             for (const auto& p : t) {
-               const Eigen::Matrix<double, 4, 4, Eigen::RowMajor> mm = p.pose.matrix();
-               v.insert(v.end(), mm.data(), mm.data() + 16);
-             }
-             return owned_array(std::move(v), {t.size(), 4, 4});
-           },
-           "(N, 4, 4) pose matrices (a copy)")
+      .def_prop_ro(
+          "stamps_ns",
+          [](const Trajectory& t) {
+            std::vector<std::int64_t> v;
+            for (const auto& p : t) v.push_back(p.stamp_ns);
+            return owned_array(std::move(v), {t.size()});
+          },
+          nb::rv_policy::move, "(N,) int64 stamps in ns (a copy)")
+      .def(
+          "matrices",
+          [](const Trajectory& t) {
+            std::vector<double> v;
+            v.reserve(16 * t.size());
+            for (const auto& p : t) {
+              const Eigen::Matrix<double, 4, 4, Eigen::RowMajor> mm = p.pose.matrix();
+              v.insert(v.end(), mm.data(), mm.data() + 16);
+            }
+            return owned_array(std::move(v), {t.size(), 4, 4});
+          },
+          "(N, 4, 4) pose matrices (a copy)")
       .def("interpolate_at", &Trajectory::interpolate_at, "stamp_ns"_a)
       .def("transformed", &Trajectory::transformed, "extrinsic"_a)
       .def("path_length_m", &Trajectory::path_length_m)

@@ -6,8 +6,8 @@
 #include <nanobind/stl/vector.h>
 
 #include "bindings.hpp"
-#include "repr.hpp"
 #include "farlio/eval/metrics.hpp"
+#include "repr.hpp"
 
 namespace nb = nanobind;
 using namespace nb::literals;
@@ -16,7 +16,6 @@ namespace farlio::python {
 namespace {
 
 using namespace farlio::eval;
-
 
 /// A numpy array owning a copy of `values`.
 template <typename T>
@@ -99,12 +98,16 @@ void bind_results(nb::module_& m) {
       .def_ro("rotation_deg", &ApeResult::rotation_deg)
       .def_ro("translation_raw_m", &ApeResult::translation_raw_m)
       .def_ro("rotation_raw_deg", &ApeResult::rotation_raw_deg)
-      .def_prop_ro("translation_errors_m", [](const ApeResult& r) { return to_numpy(r.translation_errors_m); }, nb::rv_policy::move)
-      .def_prop_ro("rotation_errors_deg", [](const ApeResult& r) { return to_numpy(r.rotation_errors_deg); }, nb::rv_policy::move)
+      .def_prop_ro(
+          "translation_errors_m", [](const ApeResult& r) { return to_numpy(r.translation_errors_m); },
+          nb::rv_policy::move)
+      .def_prop_ro(
+          "rotation_errors_deg", [](const ApeResult& r) { return to_numpy(r.rotation_errors_deg); },
+          nb::rv_policy::move)
       .def_prop_ro(
           "aligned_positions_m", [](const ApeResult& r) { return positions(r.aligned_estimate); }, nb::rv_policy::move)
-      .def("__repr__", attribute_repr({"translation_m", "rotation_deg", "translation_raw_m", "rotation_raw_deg",
-                                       "alignment"}));
+      .def("__repr__",
+           attribute_repr({"translation_m", "rotation_deg", "translation_raw_m", "rotation_raw_deg", "alignment"}));
   nb::class_<KittiLengthError>(m, "KittiLengthError")
       .def_ro("length_m", &KittiLengthError::length_m)
       .def_ro("segment_count", &KittiLengthError::segment_count)
@@ -117,8 +120,8 @@ void bind_results(nb::module_& m) {
       .def_ro("translation_pct", &KittiRpeResult::translation_pct)
       .def_ro("rotation_deg_per_100m", &KittiRpeResult::rotation_deg_per_100m)
       .def_ro("per_length", &KittiRpeResult::per_length)
-      .def("__repr__", attribute_repr({"segment_count", "translation_pct", "rotation_deg_per_100m",
-                                       "segment_lengths_m"}));
+      .def("__repr__",
+           attribute_repr({"segment_count", "translation_pct", "rotation_deg_per_100m", "segment_lengths_m"}));
   nb::class_<DeltaRpeResult>(m, "DeltaRpeResult")
       .def_ro("pairs", &DeltaRpeResult::pairs)
       .def_ro("translation_m", &DeltaRpeResult::translation_m)
@@ -133,8 +136,11 @@ void bind_results(nb::module_& m) {
       .def_ro("associated_poses", &EvaluationResult::associated_poses)
       .def_ro("coverage", &EvaluationResult::coverage)
       .def_ro("groundtruth_path_length_m", &EvaluationResult::groundtruth_path_length_m)
-      .def_prop_ro("stamps_ns", [](const EvaluationResult& r) { return to_numpy(r.stamps_ns); }, nb::rv_policy::move)
-      .def_prop_ro("groundtruth_positions_m", [](const EvaluationResult& r) { return positions(r.groundtruth); }, nb::rv_policy::move)
+      .def_prop_ro(
+          "stamps_ns", [](const EvaluationResult& r) { return to_numpy(r.stamps_ns); }, nb::rv_policy::move)
+      .def_prop_ro(
+          "groundtruth_positions_m", [](const EvaluationResult& r) { return positions(r.groundtruth); },
+          nb::rv_policy::move)
       .def_ro("ape", &EvaluationResult::ape)
       .def_ro("kitti_rpe", &EvaluationResult::kitti_rpe)
       .def_ro("rpe", &EvaluationResult::rpe)

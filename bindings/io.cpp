@@ -8,12 +8,12 @@
 #include <nanobind/stl/vector.h>
 
 #include "bindings.hpp"
-#include "repr.hpp"
 #include "farlio/io/calibration.hpp"
 #include "farlio/io/point_cloud_io.hpp"
 #include "farlio/io/rigid_transform.hpp"
 #include "farlio/io/sequence.hpp"
 #include "farlio/io/trajectory_io.hpp"
+#include "repr.hpp"
 
 namespace nb = nanobind;
 using namespace nb::literals;
@@ -61,7 +61,9 @@ void bind_point_clouds(nb::module_& m) {
         "Reads a .pcd/.ply/.bin file (optionally .gz) into a Scan (stamps 0).");
   m.def(
       "write_pcd",
-      [](const Path& path, const Scan& scan, const std::string& encoding) { write_pcd(path, scan, encoding_from(encoding)); },
+      [](const Path& path, const Scan& scan, const std::string& encoding) {
+        write_pcd(path, scan, encoding_from(encoding));
+      },
       "path"_a, "scan"_a, "encoding"_a = "binary",
       "Writes x y z [intensity] [t] float32 [sensor_id] uint8; encoding ascii, binary or binary_compressed.");
   m.def(
@@ -145,7 +147,9 @@ void bind_sequence(nb::module_& m) {
       .def("write_calibration", &SequenceWriter::write_calibration, "calibration"_a)
       .def(
           "write_scan",
-          [](SequenceWriter& w, const Scan& scan, const std::string& encoding) { w.write_scan(scan, encoding_from(encoding)); },
+          [](SequenceWriter& w, const Scan& scan, const std::string& encoding) {
+            w.write_scan(scan, encoding_from(encoding));
+          },
           "scan"_a, "encoding"_a = "binary")
       .def("write_imu", &SequenceWriter::write_imu, "samples"_a)
       .def("write_groundtruth", &SequenceWriter::write_groundtruth, "body_poses"_a)

@@ -1,5 +1,4 @@
 #include "bindings.hpp"
-
 #include "farlio/core/error.hpp"
 
 namespace nb = nanobind;

@@ -1,21 +1,21 @@
 // Bindings of the parameter set and the scan pipeline.
 #include <nanobind/eigen/dense.h>
 #include <nanobind/stl/optional.h>
+#include <nanobind/stl/pair.h>
 #include <nanobind/stl/string.h>
 #include <nanobind/stl/tuple.h>
 #include <nanobind/stl/vector.h>
-#include <nanobind/stl/pair.h>
 
 #include <mutex>
 #include <utility>
 
 #include "bindings.hpp"
-#include "repr.hpp"
 #include "farlio/core/config_fields.hpp"
 #include "farlio/pipeline/odometry.hpp"
 #include "farlio/pipeline/online_odometry.hpp"
 #include "farlio/pipeline/pairwise.hpp"
 #include "farlio/pipeline/scan_pipeline.hpp"
+#include "repr.hpp"
 
 namespace nb = nanobind;
 using namespace nb::literals;
@@ -95,7 +95,8 @@ void bind_pipeline(nb::module_& m) {
                      "The one parameter set; fields by dotted name, e.g. 'map.voxel_size_m', with their types.")
       .def(nb::init<>())
       .def(
-          "set", [](Config& c, const std::string& name, nb::handle value) { set_config_field(c, name, text_of(value)); },
+          "set",
+          [](Config& c, const std::string& name, nb::handle value) { set_config_field(c, name, text_of(value)); },
           "name"_a, "value"_a,
           "Sets a field from a number, bool or text; ValueError naming the field if it is unknown or out of range.")
       .def(
@@ -190,15 +191,16 @@ void bind_pipeline(nb::module_& m) {
       .def_prop_ro("gradient", [](const registration::RegistrationResult& r) { return r.system.b; })
       .def_prop_ro("error", [](const registration::RegistrationResult& r) { return r.system.error; })
       .def_prop_ro("inliers", [](const registration::RegistrationResult& r) { return r.system.inliers; })
-      .def("__repr__", attribute_repr({"pose", "iterations", "converged", "budget_exceeded", "time_s", "error",
-                                       "inliers"}));
+      .def("__repr__",
+           attribute_repr({"pose", "iterations", "converged", "budget_exceeded", "time_s", "error", "inliers"}));
 
   m.def(
       "register_pair",
       [](const Scan& source, const Scan& target, const SE3& guess, const Config& config) {
         return pipeline::register_pair(source.points, target.points, guess, config);
       },
-      "source"_a, "target"_a, "initial_guess"_a = SE3(), "config"_a = Config(), nb::call_guard<nb::gil_scoped_release>(),
+      "source"_a, "target"_a, "initial_guess"_a = SE3(), "config"_a = Config(),
+      nb::call_guard<nb::gil_scoped_release>(),
       "T_target_source by sparsity-aware GICP (the target becomes a voxel map).");
 
   nb::enum_<pipeline::LatencyModel>(m, "LatencyModel")
@@ -232,9 +234,9 @@ void bind_pipeline(nb::module_& m) {
       .def_ro("accel_unit_message", &fusion::FusionStats::accel_unit_message)
       .def_ro("gyro_bias_rad_s", &fusion::FusionStats::gyro_bias_rad_s)
       .def_ro("last_warning", &fusion::FusionStats::last_warning)
-      .def("__repr__", attribute_repr({"steps", "lidar_groups_accepted", "lidar_groups_rejected", "reinitializations",
-                                       "imu_gaps", "imu_samples_dropped", "accel_in_g", "gyro_bias_rad_s",
-                                       "last_warning"}));
+      .def("__repr__",
+           attribute_repr({"steps", "lidar_groups_accepted", "lidar_groups_rejected", "reinitializations", "imu_gaps",
+                           "imu_samples_dropped", "accel_in_g", "gyro_bias_rad_s", "last_warning"}));
   nb::class_<PyOdometry>(m, "Odometry",
                          "LiDAR-inertial odometry replayed on a simulated clock (LiDAR-only without IMU).")
       .def(nb::init<const Config&, const SE3&, double, std::vector<ImuSample>, const pipeline::ReplayOptions&>(),
@@ -255,20 +257,22 @@ void bind_pipeline(nb::module_& m) {
           },
           "[(stamp_ns, body pose)] of the 10 ms odometry output since the last call.")
       .def_prop_ro("inertial", [](const PyOdometry& o) { return o.odometry.inertial(); })
-      .def_prop_ro("effective_config", [](const PyOdometry& o) { return o.odometry.scan_pipeline().config(); },
-                   "The parameters in use (the voxel size is fixed at the first scan when auto).")
+      .def_prop_ro(
+          "effective_config", [](const PyOdometry& o) { return o.odometry.scan_pipeline().config(); },
+          "The parameters in use (the voxel size is fixed at the first scan when auto).")
       .def_prop_ro("fusion_stats", [](const PyOdometry& o) { return o.odometry.fusion_stats(); })
       .def_prop_ro("initial_body_pose", [](const PyOdometry& o) { return o.odometry.initial_body_pose(); })
       .def(
-          "map_points",
-[](const PyOdometry& o) { return map_points(o.odometry.scan_pipeline().backend()); },
+          "map_points", [](const PyOdometry& o) { return map_points(o.odometry.scan_pipeline().backend()); },
           "(N, 3) float32 copy of the submap's points (world frame)")
       .def_prop_ro("map_memory_bytes",
                    [](const PyOdometry& o) { return o.odometry.scan_pipeline().backend().memory_bytes(); })
-      .def_prop_ro("device", [](const PyOdometry& o) { return device_name(o.odometry.scan_pipeline().backend().device()); },
-                   "'cpu' or 'cuda': the backend the scan pipeline runs on")
-      .def_prop_ro("device_message", [](const PyOdometry& o) { return o.odometry.scan_pipeline().device_message(); },
-                   "why device auto fell back to the CPU ('' when it did not)");
+      .def_prop_ro(
+          "device", [](const PyOdometry& o) { return device_name(o.odometry.scan_pipeline().backend().device()); },
+          "'cpu' or 'cuda': the backend the scan pipeline runs on")
+      .def_prop_ro(
+          "device_message", [](const PyOdometry& o) { return o.odometry.scan_pipeline().device_message(); },
+          "why device auto fell back to the CPU ('' when it did not)");
 
   nb::class_<pipeline::OdometrySample>(m, "OdometrySample", "One 10 ms sample of the fused odometry.")
       .def_ro("stamp_ns", &pipeline::OdometrySample::stamp_ns)
@@ -290,10 +294,12 @@ void bind_pipeline(nb::module_& m) {
           "Blocks until every scan handed over is processed.")
       .def(
           "stop", [](PyOnlineOdometry& o) { o.odometry.stop(); }, nb::call_guard<nb::gil_scoped_release>())
-      .def("take_odometry", [](PyOnlineOdometry& o) { return o.take(o.samples); },
-           "The 10 ms odometry samples since the last call.")
-      .def("take_frames", [](PyOnlineOdometry& o) { return o.take(o.frames); },
-           "What happened to each scan since the last call (processed or dropped, pose, timings).")
+      .def(
+          "take_odometry", [](PyOnlineOdometry& o) { return o.take(o.samples); },
+          "The 10 ms odometry samples since the last call.")
+      .def(
+          "take_frames", [](PyOnlineOdometry& o) { return o.take(o.frames); },
+          "What happened to each scan since the last call (processed or dropped, pose, timings).")
       .def_prop_ro("inertial", [](PyOnlineOdometry& o) { return o.odometry.inertial(); })
       .def_prop_ro("scans_dropped_busy", [](PyOnlineOdometry& o) { return o.odometry.scans_dropped_busy(); });
 
@@ -309,12 +315,12 @@ void bind_pipeline(nb::module_& m) {
           "Registers one scan; without a guess the constant-velocity model supplies one.")
       .def_prop_ro("frames", &pipeline::ScanPipeline::frames)
       .def(
-          "map_points",
-[](const pipeline::ScanPipeline& p) { return map_points(p.backend()); },
+          "map_points", [](const pipeline::ScanPipeline& p) { return map_points(p.backend()); },
           "(N, 3) float32 copy of the submap's points (world frame)")
       .def_prop_ro("map_memory_bytes", [](const pipeline::ScanPipeline& p) { return p.backend().memory_bytes(); })
-      .def_prop_ro("device", [](const pipeline::ScanPipeline& p) { return device_name(p.backend().device()); },
-                   "'cpu' or 'cuda': the backend the stages run on")
+      .def_prop_ro(
+          "device", [](const pipeline::ScanPipeline& p) { return device_name(p.backend().device()); },
+          "'cpu' or 'cuda': the backend the stages run on")
       .def_prop_ro("device_message", &pipeline::ScanPipeline::device_message,
                    "why device auto fell back to the CPU ('' when it did not)");
 }

@@ -3,10 +3,10 @@
 // kReprDigits significant digits, bools as True/False, text quoted, vectors as [x, y, z],
 // poses as SE3(t=[x, y, z], rpy_deg=[roll, pitch, yaw]), optional values as None when empty.
 // Most classes list the attributes to show (attribute_repr); a few build their text (Repr).
-#include <Eigen/Core>
 #include <nanobind/nanobind.h>
 #include <nanobind/stl/string.h>
 
+#include <Eigen/Core>
 #include <algorithm>
 #include <array>
 #include <charconv>
@@ -47,8 +47,8 @@ std::string repr_value(const T& v) {
   } else if constexpr (std::is_floating_point_v<T>) {
     const double x = v == 0 ? 0.0 : static_cast<double>(v);  // no "-0"
     std::array<char, 32> text{};
-    const auto end = std::to_chars(text.data(), text.data() + text.size(), x, std::chars_format::general,
-                                   kReprDigits).ptr;
+    const auto end =
+        std::to_chars(text.data(), text.data() + text.size(), x, std::chars_format::general, kReprDigits).ptr;
     return {text.data(), end};
   } else if constexpr (std::is_convertible_v<T, std::string_view>) {
     return "'" + std::string(std::string_view(v)) + "'";

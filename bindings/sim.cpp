@@ -12,8 +12,7 @@ namespace nb = nanobind;
 using namespace nb::literals;
 
 namespace farlio::python {
-namespace {
-}  // namespace
+namespace {}  // namespace
 
 void bind_sim(nb::module_& m) {
   using namespace farlio::sim;

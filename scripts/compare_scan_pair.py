@@ -3,14 +3,14 @@
 2 m voxels) and, if the `small_gicp` package is installed (pip install small_gicp), with
 small_gicp's factors at several downsampling resolutions, printing each result's distance to
 T_target_source.txt. Used to set the bounds of tests/cpp/test_scan_pair.cpp."""
+
 from __future__ import annotations
 
 import sys
 from pathlib import Path
 
-import numpy as np
-
 import farlio
+import numpy as np
 from farlio import _core
 
 DATA = Path(sys.argv[1]) if len(sys.argv) > 1 else Path(__file__).resolve().parents[2] / "shared/data/real/scan_pair"
@@ -29,8 +29,10 @@ def main() -> None:
         cfg = _core.Config()
         cfg.set("map.voxel_size_m", str(voxel))
         r = _core.register_pair(src, tgt, farlio.SE3(), cfg)
-        print(f"farlio voxel {voxel} m: translation {error(gt, r.pose.matrix())[0]:.4f} m, "
-              f"rotation {error(gt, r.pose.matrix())[1]:.4f} deg")
+        print(
+            f"farlio voxel {voxel} m: translation {error(gt, r.pose.matrix())[0]:.4f} m, "
+            f"rotation {error(gt, r.pose.matrix())[1]:.4f} deg"
+        )
     try:
         import small_gicp
     except ImportError:
@@ -40,8 +42,14 @@ def main() -> None:
     S = small_gicp.read_ply(str(DATA / "source.ply"))
     for res in (0.1, 0.25, 0.5, 1.0):
         for reg in ("GICP", "VGICP", "PLANE_ICP", "ICP"):
-            r = small_gicp.align(T.points(), S.points(), registration_type=reg, downsampling_resolution=res,
-                                 voxel_resolution=max(4 * res, 1.0), num_threads=2)
+            r = small_gicp.align(
+                T.points(),
+                S.points(),
+                registration_type=reg,
+                downsampling_resolution=res,
+                voxel_resolution=max(4 * res, 1.0),
+                num_threads=2,
+            )
             t, a = error(gt, r.T_target_source)
             print(f"small_gicp {reg:9s} downsampling {res:4.2f} m: translation {t:.4f} m, rotation {a:.4f} deg")
 

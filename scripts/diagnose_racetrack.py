@@ -6,13 +6,13 @@ a move of minus the distance travelled. Usage:
   farlio simulate racetrack --duration 6 --out rt && python scripts/diagnose_racetrack.py rt [name=value ...]
 e.g. registration.point_to_point_sigma_m=0.0316 registration.skip_line_pairs=false (the paper's weighting).
 """
+
 from __future__ import annotations
 
 import sys
 
-import numpy as np
-
 import farlio
+import numpy as np
 from farlio import _core
 from farlio._core import NS_PER_S
 
@@ -51,8 +51,10 @@ def main() -> None:
         r = _core.register_pair(undistorted(i), target, truth, cfg)
         moved = (truth.inverse() * r.pose).translation
         worst = max(worst, float(np.linalg.norm(moved)))
-        print(f"scan {i:4d}: travelled {np.linalg.norm(truth.translation):6.2f} m, registration moved "
-              f"{np.linalg.norm(moved):.3f} m (along x {moved[0]:+.3f} m) from the true pose")
+        print(
+            f"scan {i:4d}: travelled {np.linalg.norm(truth.translation):6.2f} m, registration moved "
+            f"{np.linalg.norm(moved):.3f} m (along x {moved[0]:+.3f} m) from the true pose"
+        )
     print(f"largest move: {worst:.3f} m")
 
 

@@ -6,7 +6,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 APT_PACKAGES=(
-  build-essential cmake ninja-build pkg-config ccache
+  build-essential cmake ninja-build pkg-config ccache clang-format
   libeigen3-dev libtbb-dev libyaml-cpp-dev zlib1g-dev
   libgtest-dev libbenchmark-dev
   python3 python3-dev python3-venv

@@ -2,6 +2,7 @@
 """Accuracy of the LIO and of LiDAR-only odometry on generated urban (10 s) and handheld (25 s)
 sequences (seed 1, fixed 20 ms latency): the measured values behind the bounds of
 tests/python/test_odometry.py and the table in docs/odometry.md."""
+
 from __future__ import annotations
 
 import tempfile
@@ -19,11 +20,19 @@ def main() -> None:
         generate(profile, root / profile, duration_s=duration)
         for mode in ("lio", "lidar-only"):
             cfg = load_config(None, [] if mode == "lio" else ["fusion.enabled=false"])
-            s = run_dataset(open_dataset(root / profile), root / f"{profile}_{mode}", cfg, progress=False, plot=False,
-                            options=replay_options("fixed", 0.02))
+            s = run_dataset(
+                open_dataset(root / profile),
+                root / f"{profile}_{mode}",
+                cfg,
+                progress=False,
+                plot=False,
+                options=replay_options("fixed", 0.02),
+            )
             a, o = s["accuracy"], s.get("accuracy_odometry")
-            line = (f"{profile} {duration:g} s {mode}: scan poses APE {a['ape']['translation_m']['rmse']:.4f} m, "
-                    f"RPE {a['kitti_rpe']['translation_pct']:.3f} %")
+            line = (
+                f"{profile} {duration:g} s {mode}: scan poses APE {a['ape']['translation_m']['rmse']:.4f} m, "
+                f"RPE {a['kitti_rpe']['translation_pct']:.3f} %"
+            )
             if o:
                 line += f"; 100 Hz odometry APE {o['ape']['translation_m']['rmse']:.4f} m"
             print(line + f" (voxel {s['voxel_size_m']:.2f} m)")

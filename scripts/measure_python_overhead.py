@@ -11,6 +11,7 @@ The binding overhead is the call minus the pipeline. Prints medians in ms.
 
     .venv/bin/python scripts/measure_python_overhead.py [--seconds 5] [--threads 2]
 """
+
 from __future__ import annotations
 
 import argparse
@@ -47,8 +48,13 @@ def measure(dataset, threads: int) -> dict[str, float]:
         call.append((t2 - t1) * MS_PER_S)
         pipeline.append(fr.scan.timings.total_s * MS_PER_S)
     med = statistics.median
-    return {"frames": len(load), "load_ms": med(load), "call_ms": med(call), "pipeline_ms": med(pipeline),
-            "binding_ms": med(c - p for c, p in zip(call, pipeline))}
+    return {
+        "frames": len(load),
+        "load_ms": med(load),
+        "call_ms": med(call),
+        "pipeline_ms": med(pipeline),
+        "binding_ms": med(c - p for c, p in zip(call, pipeline)),
+    }
 
 
 def main() -> int:
@@ -61,13 +67,18 @@ def main() -> int:
         write_sequence(make_config("urban", duration_s=args.seconds), folder)
         seq = open_dataset(folder)
         bag = write_dataset(seq, Path(tmp) / "bag", "mcap", "ouster")
-        rows = {"sequence folder": measure(seq, args.threads), "ROS 2 MCAP bag": measure(open_dataset(bag), args.threads)}
+        rows = {
+            "sequence folder": measure(seq, args.threads),
+            "ROS 2 MCAP bag": measure(open_dataset(bag), args.threads),
+        }
     print(f"urban, {args.seconds:g} s, threads {args.threads or 'all'}; medians per frame in ms")
     print(f"{'input':18s} {'frames':>6s} {'load':>8s} {'binding':>8s} {'C++ pipeline':>13s} {'Python share':>13s}")
     for name, r in rows.items():
         share = (r["load_ms"] + r["binding_ms"]) / (r["load_ms"] + r["call_ms"])
-        print(f"{name:18s} {r['frames']:6d} {r['load_ms']:8.2f} {r['binding_ms']:8.3f} {r['pipeline_ms']:13.2f} "
-              f"{100 * share:12.1f}%")
+        print(
+            f"{name:18s} {r['frames']:6d} {r['load_ms']:8.2f} {r['binding_ms']:8.3f} {r['pipeline_ms']:13.2f} "
+            f"{100 * share:12.1f}%"
+        )
     return 0
 
 

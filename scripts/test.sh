@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Runs every test of farlio: the C++ tests (ctest), the same C++ tests under AddressSanitizer +
-# UndefinedBehaviorSanitizer, and the Python tests (pytest) against the installed package. The
+# Runs every test of farlio: the style check (clang-format, ruff), the C++ tests (ctest), the
+# same C++ tests under AddressSanitizer + UndefinedBehaviorSanitizer, and the Python tests
+# (pytest) against the installed package. The
 # GPU tests are built and skip without a GPU; scripts/gpu_check.sh runs them on one.
 # Expects scripts/install_deps.sh to have run. Tests that need ../shared/data or a GPU skip
 # cleanly when it is absent.
@@ -12,6 +13,9 @@ export CCACHE_BASEDIR="$PWD" CCACHE_NOHASHDIR=1 CMAKE_CXX_COMPILER_LAUNCHER=ccac
 # The CUDA backend only has to compile and link here (no GPU): two architectures, the oldest and
 # the newest of the default list (docs/cuda.md), instead of six; the C++ build and pip both read it.
 export FARLIO_CUDA_ARCHITECTURES="${FARLIO_CUDA_ARCHITECTURES:-75;90}"
+
+echo "== Format (clang-format, ruff) =="
+bash scripts/check_format.sh
 
 echo "== C++ build and tests (preset dev) =="
 cmake --preset dev -DCMAKE_CUDA_ARCHITECTURES="$FARLIO_CUDA_ARCHITECTURES" >/dev/null

@@ -1,5 +1,6 @@
 """The paper's studies on a recording with ground truth: the component ablation (Table III) and
 the added-latency sweep (APE stable up to a threshold, then rising)."""
+
 from __future__ import annotations
 
 import csv
@@ -12,10 +13,25 @@ from .runner import replay_options, run_dataset
 
 #: (name, overrides): each row adds one component, as in the paper's Table III
 ABLATION_ROWS = [
-    ("none", ["fusion.enabled=false", "fusion.delay_compensation=false", "preprocess.undistort=false",
-              "registration.sparsity_aware=false", "density.enabled=false"]),
-    ("EKF", ["fusion.delay_compensation=false", "preprocess.undistort=false", "registration.sparsity_aware=false",
-             "density.enabled=false"]),
+    (
+        "none",
+        [
+            "fusion.enabled=false",
+            "fusion.delay_compensation=false",
+            "preprocess.undistort=false",
+            "registration.sparsity_aware=false",
+            "density.enabled=false",
+        ],
+    ),
+    (
+        "EKF",
+        [
+            "fusion.delay_compensation=false",
+            "preprocess.undistort=false",
+            "registration.sparsity_aware=false",
+            "density.enabled=false",
+        ],
+    ),
     ("EKF+DC", ["preprocess.undistort=false", "registration.sparsity_aware=false", "density.enabled=false"]),
     ("EKF+DC+MU", ["registration.sparsity_aware=false", "density.enabled=false"]),
     ("EKF+DC+MU+SA", ["density.enabled=false"]),
@@ -36,23 +52,45 @@ def ablate(sequence: Path, out_dir: Path, *, latency: str = "measured", max_fram
     """Runs every row of ABLATION_ROWS; writes ablation.csv and ablation.md into out_dir."""
     rows = []
     for name, overrides in ABLATION_ROWS:
-        s = run_dataset(open_dataset(sequence), out_dir / name.replace("+", "_"), load_config(None, overrides),
-                        progress=False, plot=False, options=replay_options(latency, 0.0), max_frames=max_frames)
+        s = run_dataset(
+            open_dataset(sequence),
+            out_dir / name.replace("+", "_"),
+            load_config(None, overrides),
+            progress=False,
+            plot=False,
+            options=replay_options(latency, 0.0),
+            max_frames=max_frames,
+        )
         ape, rpe = _accuracy(s)
-        rows.append({"components": name, "ape_m": ape, "rpe_pct": rpe, "dropped": s["dropped"],
-                     "median_ms": s["latency_ms"]["median"]})
+        rows.append(
+            {
+                "components": name,
+                "ape_m": ape,
+                "rpe_pct": rpe,
+                "dropped": s["dropped"],
+                "median_ms": s["latency_ms"]["median"],
+            }
+        )
     _write(out_dir, "ablation", rows)
     return rows
 
 
-def latency_sweep(sequence: Path, out_dir: Path, delays_s: list[float], *, max_frames: int | None = None,
-                  plot: bool = True) -> list[dict]:
+def latency_sweep(
+    sequence: Path, out_dir: Path, delays_s: list[float], *, max_frames: int | None = None, plot: bool = True
+) -> list[dict]:
     """Runs the LIO with each added delay on top of the measured latency; writes latency_sweep.csv,
     latency_sweep.md and (plot) latency_sweep.png into out_dir."""
     rows = []
     for d in delays_s:
-        s = run_dataset(open_dataset(sequence), out_dir / f"delay_{d * 1e3:.0f}ms", load_config(None),
-                        progress=False, plot=False, options=replay_options("measured", 0.0, d), max_frames=max_frames)
+        s = run_dataset(
+            open_dataset(sequence),
+            out_dir / f"delay_{d * 1e3:.0f}ms",
+            load_config(None),
+            progress=False,
+            plot=False,
+            options=replay_options("measured", 0.0, d),
+            max_frames=max_frames,
+        )
         ape, rpe = _accuracy(s)
         rows.append({"added_delay_ms": d * 1e3, "ape_m": ape, "rpe_pct": rpe, "dropped": s["dropped"]})
     _write(out_dir, "latency_sweep", rows)

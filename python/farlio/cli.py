@@ -3,6 +3,7 @@
 Every subcommand that writes files takes ``--out DIR``; ``farlio <command> --help`` documents
 every option.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -29,8 +30,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     sub = parser.add_subparsers(dest="command", metavar="<command>", required=True)
     for name, (module, help_text) in COMMANDS.items():
-        p = sub.add_parser(name, help=help_text, description=help_text,
-                           formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+        p = sub.add_parser(
+            name, help=help_text, description=help_text, formatter_class=argparse.ArgumentDefaultsHelpFormatter
+        )
         importlib.import_module(module).add_arguments(p)
         p.set_defaults(_module=module)
     return parser

@@ -3,10 +3,12 @@
 Field names are the dotted names of the C++ Config (e.g. ``map.voxel_size_m``); a YAML file may
 nest them (``map: {voxel_size_m: 2.0}``). Unknown names are errors that name the field.
 """
+
 from __future__ import annotations
 
+from collections.abc import Iterable
 from pathlib import Path
-from typing import Any, Iterable
+from typing import Any
 
 import yaml
 

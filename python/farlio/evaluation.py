@@ -3,13 +3,15 @@
 The metrics themselves (association, APE, KITTI-style and evo-style RPE, coverage) are computed by
 ``farlio._core.eval.evaluate``; see docs/evaluation.md for their definitions.
 """
+
 from __future__ import annotations
 
 import argparse
 import json
 import math
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
 
 from farlio import _core
 from farlio._core import NS_PER_S
@@ -23,10 +25,19 @@ PLOT_SIZE_IN = (12.0, 5.0)
 PLOT_DPI = 120
 
 
-def make_options(*, max_time_diff_s: float | None = None, nearest: bool = False, align_scale: bool = False,
-                 kitti_step: int | None = None, segment_lengths_m: list[float] | None = None,
-                 rpe_delta: float | None = None, rpe_unit: str = "frames", rpe_all_pairs: bool = False,
-                 rpe_pairs_from_estimate: bool = False, scan_stamps_ns: Sequence[int] | None = None):
+def make_options(
+    *,
+    max_time_diff_s: float | None = None,
+    nearest: bool = False,
+    align_scale: bool = False,
+    kitti_step: int | None = None,
+    segment_lengths_m: list[float] | None = None,
+    rpe_delta: float | None = None,
+    rpe_unit: str = "frames",
+    rpe_all_pairs: bool = False,
+    rpe_pairs_from_estimate: bool = False,
+    scan_stamps_ns: Sequence[int] | None = None,
+):
     """EvalOptions from keyword arguments; None keeps the C++ default."""
     ev = _core.eval
     o = ev.EvalOptions()
@@ -86,8 +97,12 @@ def result_to_dict(r) -> dict[str, Any]:
             "translation_pct": k.translation_pct,
             "rotation_deg_per_100m": k.rotation_deg_per_100m,
             "per_length": [
-                {"length_m": p.length_m, "segment_count": p.segment_count,
-                 "translation_pct": p.translation_pct, "rotation_deg_per_100m": p.rotation_deg_per_100m}
+                {
+                    "length_m": p.length_m,
+                    "segment_count": p.segment_count,
+                    "translation_pct": p.translation_pct,
+                    "rotation_deg_per_100m": p.rotation_deg_per_100m,
+                }
                 for p in k.per_length
             ],
         },
@@ -140,9 +155,18 @@ def _json_safe(value):
     return value
 
 
-def evaluate_files(estimate: Path, groundtruth: Path, out_dir: Path | None = None, *, fmt: str = "auto",
-                   plot: bool = True, estimate_times: Path | None = None, groundtruth_times: Path | None = None,
-                   scan_stamps: Path | None = None, **options) -> dict[str, Any]:
+def evaluate_files(
+    estimate: Path,
+    groundtruth: Path,
+    out_dir: Path | None = None,
+    *,
+    fmt: str = "auto",
+    plot: bool = True,
+    estimate_times: Path | None = None,
+    groundtruth_times: Path | None = None,
+    scan_stamps: Path | None = None,
+    **options,
+) -> dict[str, Any]:
     """Evaluates an estimated trajectory file against a ground-truth file.
 
     fmt: "tum", "kitti" or "auto" (by column count). KITTI files take a times file each; one given
@@ -173,6 +197,7 @@ def evaluate_files(estimate: Path, groundtruth: Path, out_dir: Path | None = Non
 
 # ---- command line -----------------------------------------------------------------------------
 
+
 def add_eval_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("estimate", type=Path, help="estimated trajectory (TUM or KITTI)")
     parser.add_argument("groundtruth", type=Path, help="ground-truth trajectory (TUM or KITTI)")
@@ -193,17 +218,34 @@ def add_eval_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run_eval(args: argparse.Namespace) -> int:
     summary = evaluate_files(
-        args.estimate, args.groundtruth, args.out, fmt=args.fmt, plot=not args.no_plot,
-        estimate_times=args.times, scan_stamps=args.scan_stamps, max_time_diff_s=args.max_time_diff,
-        nearest=args.nearest, align_scale=args.align_scale, kitti_step=args.kitti_step,
-        segment_lengths_m=args.segments, rpe_delta=args.rpe_delta, rpe_unit=args.rpe_unit,
-        rpe_all_pairs=args.rpe_all_pairs)
+        args.estimate,
+        args.groundtruth,
+        args.out,
+        fmt=args.fmt,
+        plot=not args.no_plot,
+        estimate_times=args.times,
+        scan_stamps=args.scan_stamps,
+        max_time_diff_s=args.max_time_diff,
+        nearest=args.nearest,
+        align_scale=args.align_scale,
+        kitti_step=args.kitti_step,
+        segment_lengths_m=args.segments,
+        rpe_delta=args.rpe_delta,
+        rpe_unit=args.rpe_unit,
+        rpe_all_pairs=args.rpe_all_pairs,
+    )
     ape, kitti = summary["ape"], summary["kitti_rpe"]
-    print(f"associated {summary['associated_poses']}/{summary['estimate_poses']} poses, "
-          f"coverage {100 * summary['coverage']:.1f} %")
-    print(f"APE aligned RMSE {ape['translation_m']['rmse']:.4f} m, raw {ape['translation_raw_m']['rmse']:.4f} m, "
-          f"rotation {ape['rotation_deg']['rmse']:.3f} deg")
-    print(f"KITTI RPE {kitti['translation_pct']:.3f} %, {kitti['rotation_deg_per_100m']:.4f} deg/100 m "
-          f"({kitti['segment_count']} segments)")
+    print(
+        f"associated {summary['associated_poses']}/{summary['estimate_poses']} poses, "
+        f"coverage {100 * summary['coverage']:.1f} %"
+    )
+    print(
+        f"APE aligned RMSE {ape['translation_m']['rmse']:.4f} m, raw {ape['translation_raw_m']['rmse']:.4f} m, "
+        f"rotation {ape['rotation_deg']['rmse']:.3f} deg"
+    )
+    print(
+        f"KITTI RPE {kitti['translation_pct']:.3f} %, {kitti['rotation_deg_per_100m']:.4f} deg/100 m "
+        f"({kitti['segment_count']} segments)"
+    )
     print(f"RPE RMSE {summary['rpe']['translation_m']['rmse']:.4f} m -> {args.out / JSON_NAME}")
     return 0

@@ -1,6 +1,7 @@
 """Pictures of a run, written into its output folder: trajectory.png (the estimated body path seen
 from above, with the ground truth when there is one) and latency.png (histogram of the per-frame
 processing time with its median and p99)."""
+
 from __future__ import annotations
 
 import csv
@@ -23,6 +24,7 @@ def _pyplot():
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
     return plt
 
 

@@ -1,4 +1,5 @@
 """A one-line progress display with a live frame rate (stderr, only on a terminal)."""
+
 from __future__ import annotations
 
 import sys
@@ -26,8 +27,9 @@ class Progress:
         rate = done / max(now - self.start, 1e-9)
         width = 30
         filled = int(width * done / max(self.total, 1))
-        sys.stderr.write(f"\r{self.label} [{'#' * filled}{'.' * (width - filled)}] {done}/{self.total} "
-                         f"{rate:5.1f} Hz {extra}   ")
+        sys.stderr.write(
+            f"\r{self.label} [{'#' * filled}{'.' * (width - filled)}] {done}/{self.total} {rate:5.1f} Hz {extra}   "
+        )
         sys.stderr.flush()
 
     def close(self) -> None:

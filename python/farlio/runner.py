@@ -13,6 +13,7 @@ Outputs in the output folder (every trajectory file names its frame):
   map.ply, map.pcd       the final submap, world frame (with --save-map)
   trajectory.png, latency.png   the estimated path (with ground truth) and the latency histogram (with plot)
 """
+
 from __future__ import annotations
 
 import json
@@ -35,8 +36,11 @@ from .timing_csv import MS_PER_S, TIMING_CSV, TimingCsv
 
 #: values of --device and of the config field device
 DEVICES = ("auto", "cpu", "cuda")
-LATENCY_MODELS = {"measured": _core.LatencyModel.Measured, "zero": _core.LatencyModel.Zero,
-                  "fixed": _core.LatencyModel.Fixed}
+LATENCY_MODELS = {
+    "measured": _core.LatencyModel.Measured,
+    "zero": _core.LatencyModel.Zero,
+    "fixed": _core.LatencyModel.Fixed,
+}
 CONFIG_YAML, SUMMARY_JSON = "config.yaml", "summary.json"
 SCANS_LIDAR_TUM, SCANS_BODY_TUM, ODOMETRY_TUM = "scans_lidar.tum", "scans_body.tum", "odometry_body.tum"
 SCANS_LIDAR_KITTI = "scans_lidar_kitti.txt"
@@ -68,10 +72,20 @@ def replay_options(latency: str = "measured", fixed_latency_s: float = 0.0, adde
     return o
 
 
-def run_dataset(dataset: Dataset, out_dir: Path, config: Any = None, *, max_frames: int | None = None,
-                save_map: bool = False, groundtruth: Path | None = None, progress: bool | None = None,
-                plot: bool = True, options: Any = None, use_imu: bool = True,
-                on_frame: Callable[[int, Any, Any], None] | None = None) -> dict[str, Any]:
+def run_dataset(
+    dataset: Dataset,
+    out_dir: Path,
+    config: Any = None,
+    *,
+    max_frames: int | None = None,
+    save_map: bool = False,
+    groundtruth: Path | None = None,
+    progress: bool | None = None,
+    plot: bool = True,
+    options: Any = None,
+    use_imu: bool = True,
+    on_frame: Callable[[int, Any, Any], None] | None = None,
+) -> dict[str, Any]:
     """Runs the odometry over `dataset` and writes the outputs listed in the module doc.
 
     use_imu False runs LiDAR-only even when the recording has an IMU; on_frame(i, scan, frame
@@ -124,14 +138,18 @@ class OdometryRun:
         if self.odo.device_message:
             print(f"farlio: {self.odo.device_message}", file=sys.stderr)
         elif self.odo.device == "cuda":
-            print(f"farlio: CUDA backend, {self.odo.map_memory_bytes / BYTES_PER_MIB:.0f} MiB of device memory "
-                  "preallocated", file=sys.stderr)
+            print(
+                f"farlio: CUDA backend, {self.odo.map_memory_bytes / BYTES_PER_MIB:.0f} MiB of device memory "
+                "preallocated",
+                file=sys.stderr,
+            )
         self.lidar_tum = _core.io.TrajectoryWriter(self.out_dir / SCANS_LIDAR_TUM)
         self.body_tum = _core.io.TrajectoryWriter(self.out_dir / SCANS_BODY_TUM)
         self.odom_tum = _core.io.TrajectoryWriter(self.out_dir / ODOMETRY_TUM) if self.odo.inertial else None
 
-    def run_frames(self, max_frames: int | None, progress: bool | None,
-                   on_frame: Callable[[int, Any, Any], None] | None) -> None:
+    def run_frames(
+        self, max_frames: int | None, progress: bool | None, on_frame: Callable[[int, Any, Any], None] | None
+    ) -> None:
         self.frames = len(self.dataset) if max_frames is None else min(len(self.dataset), max_frames)
         bar = Progress(self.frames, self.dataset.name, progress)
         start = time.perf_counter()
@@ -144,8 +162,9 @@ class OdometryRun:
         bar.close()
         self.wall_s = time.perf_counter() - start
 
-    def run_frame(self, i: int, timing: TimingCsv, bar: Progress,
-                  on_frame: Callable[[int, Any, Any], None] | None) -> None:
+    def run_frame(
+        self, i: int, timing: TimingCsv, bar: Progress, on_frame: Callable[[int, Any, Any], None] | None
+    ) -> None:
         scan = self.next_scan(i)
         if scan is None:
             return
@@ -172,8 +191,10 @@ class OdometryRun:
             return None
         if self.last_stamp is not None and scan.end_stamp_ns <= self.last_stamp:
             self.counts.skipped += 1
-            _warn(f"skipping {self.dataset.scan_source(i)}: its stamp {scan.end_stamp_ns} ns is not after the "
-                  f"previous scan's {self.last_stamp} ns (time going backwards)")
+            _warn(
+                f"skipping {self.dataset.scan_source(i)}: its stamp {scan.end_stamp_ns} ns is not after the "
+                f"previous scan's {self.last_stamp} ns (time going backwards)"
+            )
             return None
         removed = scan.remove_non_finite()
         if removed:
@@ -224,10 +245,12 @@ class OdometryRun:
             "dropped": c.dropped,
             "registered": c.registered,
             "converged_fraction": c.converged / c.registered if c.registered else float("nan"),
-            "latency_ms": {"median": _percentile(totals, MEDIAN_PERCENTILE),
-                           "p99": _percentile(totals, TAIL_PERCENTILE),
-                           "max": max(totals) if totals else float("nan"),
-                           "mean": float(np.mean(totals)) if totals else float("nan")},
+            "latency_ms": {
+                "median": _percentile(totals, MEDIAN_PERCENTILE),
+                "p99": _percentile(totals, TAIL_PERCENTILE),
+                "max": max(totals) if totals else float("nan"),
+                "mean": float(np.mean(totals)) if totals else float("nan"),
+            },
             "wall_s": self.wall_s,
             "rate_hz": len(totals) / self.wall_s if self.wall_s > 0 else float("nan"),
             "device": self.odo.device,
@@ -243,6 +266,7 @@ class OdometryRun:
         """Accuracy of the scan poses and of the 100 Hz odometry against the ground truth, when there
         is one: eval_scans/, eval_odometry/ and summary["accuracy"], summary["accuracy_odometry"]."""
         from .evaluation import evaluate_files
+
         if len(self.lidar_poses) < MIN_EVALUATED_POSES:
             return
         gt_scans = groundtruth
@@ -251,17 +275,20 @@ class OdometryRun:
         if gt_scans is None:
             gt_scans = self.dataset.groundtruth()  # a dense ground truth (MulRan): interpolated at the scan stamps
         if gt_scans is not None:
-            summary["accuracy"] = evaluate_files(self.out_dir / SCANS_BODY_TUM, Path(gt_scans),
-                                                 self.out_dir / EVAL_SCANS_DIR, plot=plot)
+            summary["accuracy"] = evaluate_files(
+                self.out_dir / SCANS_BODY_TUM, Path(gt_scans), self.out_dir / EVAL_SCANS_DIR, plot=plot
+            )
         gt_dense = groundtruth or self.dataset.groundtruth()
         if gt_dense is not None and (self.out_dir / ODOMETRY_TUM).exists():
-            summary["accuracy_odometry"] = evaluate_files(self.out_dir / ODOMETRY_TUM, Path(gt_dense),
-                                                          self.out_dir / EVAL_ODOMETRY_DIR, plot=plot)
+            summary["accuracy_odometry"] = evaluate_files(
+                self.out_dir / ODOMETRY_TUM, Path(gt_dense), self.out_dir / EVAL_ODOMETRY_DIR, plot=plot
+            )
 
     def plot(self, summary: dict[str, Any]) -> None:
         """trajectory.png and latency.png, when a frame was processed."""
         if self.counts.totals_ms:
             from .plots import plot_run
+
             plot_run(self.out_dir, summary.get("accuracy", {}).get("groundtruth_file"))
 
     def write_summary(self, summary: dict[str, Any]) -> None:
@@ -278,13 +305,18 @@ def _fusion_summary(stats: Any) -> dict[str, Any]:
     if stats.accel_in_g:
         _warn(stats.accel_unit_message)
     if stats.imu_gaps:
-        _warn(f"{stats.imu_gaps} IMU gap(s): no sample for longer than fusion.imu_gap_limit_s "
-              "(the last input was held)")
-    return {"lidar_groups_accepted": stats.lidar_groups_accepted,
-            "lidar_groups_rejected": stats.lidar_groups_rejected,
-            "reinitializations": stats.reinitializations, "imu_gaps": stats.imu_gaps,
-            "imu_samples_dropped": stats.imu_samples_dropped, "accel_in_g": stats.accel_in_g,
-            "gyro_bias_rad_s": list(stats.gyro_bias_rad_s)}
+        _warn(
+            f"{stats.imu_gaps} IMU gap(s): no sample for longer than fusion.imu_gap_limit_s (the last input was held)"
+        )
+    return {
+        "lidar_groups_accepted": stats.lidar_groups_accepted,
+        "lidar_groups_rejected": stats.lidar_groups_rejected,
+        "reinitializations": stats.reinitializations,
+        "imu_gaps": stats.imu_gaps,
+        "imu_samples_dropped": stats.imu_samples_dropped,
+        "accel_in_g": stats.accel_in_g,
+        "gyro_bias_rad_s": list(stats.gyro_bias_rad_s),
+    }
 
 
 def _json_default(o: Any) -> Any:
@@ -299,9 +331,11 @@ def format_summary(s: dict[str, Any]) -> str:
     lat = s["latency_ms"]
     frac = s["converged_fraction"]
     converged = "no scan registered yet" if frac is None or math.isnan(frac) else f"{100 * frac:.1f}%"
-    lines = [f"{s['mode']}: frames {s['processed']}/{s['frames']} (skipped {s['skipped']}, dropped "
-             f"{s['dropped']}), converged {converged}, {s['rate_hz']:.1f} Hz overall",
-             f"latency per frame: median {lat['median']:.2f} ms, p99 {lat['p99']:.2f} ms, max {lat['max']:.2f} ms"]
+    lines = [
+        f"{s['mode']}: frames {s['processed']}/{s['frames']} (skipped {s['skipped']}, dropped "
+        f"{s['dropped']}), converged {converged}, {s['rate_hz']:.1f} Hz overall",
+        f"latency per frame: median {lat['median']:.2f} ms, p99 {lat['p99']:.2f} ms, max {lat['max']:.2f} ms",
+    ]
     for key, label in (("accuracy", "scan poses"), ("accuracy_odometry", "100 Hz odometry")):
         if s.get(key):
             lines.append(f"{label}: {_accuracy_line(s[key])}")
@@ -312,7 +346,9 @@ def _accuracy_line(acc: dict[str, Any]) -> str:
     try:
         ape = acc["ape"]["translation_m"]["rmse"]
         kitti = acc["kitti_rpe"]
-        return (f"APE {ape:.3f} m (aligned RMSE), RPE {kitti['translation_pct']:.3f} % / "
-                f"{kitti['rotation_deg_per_100m']:.3f} deg/100m, coverage {100 * acc['coverage']:.1f}%")
+        return (
+            f"APE {ape:.3f} m (aligned RMSE), RPE {kitti['translation_pct']:.3f} % / "
+            f"{kitti['rotation_deg_per_100m']:.3f} deg/100m, coverage {100 * acc['coverage']:.1f}%"
+        )
     except (KeyError, TypeError):
         return "see eval.json"

@@ -1,4 +1,5 @@
 """Writes generated sequences (farlio._core.sim) in the sequence folder format."""
+
 from __future__ import annotations
 
 import time
@@ -12,8 +13,9 @@ from farlio import _core
 GROUNDTRUTH_RATE_HZ = 100.0
 
 
-def make_config(profile: str, *, seed: int = 1, duration_s: float | None = None, noise_free: bool = False,
-                **noise: float) -> Any:
+def make_config(
+    profile: str, *, seed: int = 1, duration_s: float | None = None, noise_free: bool = False, **noise: float
+) -> Any:
     """The profile's defaults with the given overrides (noise fields by their NoiseConfig name)."""
     cfg = _core.sim.default_config(profile)
     cfg.seed = seed
@@ -31,8 +33,14 @@ def make_config(profile: str, *, seed: int = 1, duration_s: float | None = None,
     return cfg
 
 
-def write_sequence(config: Any, out_dir: Path, *, kitti: bool = False, encoding: str = "binary",
-                   on_scan: Callable[[int, int], None] | None = None) -> dict[str, Any]:
+def write_sequence(
+    config: Any,
+    out_dir: Path,
+    *,
+    kitti: bool = False,
+    encoding: str = "binary",
+    on_scan: Callable[[int, int], None] | None = None,
+) -> dict[str, Any]:
     """Generates and writes a sequence folder (lidar/, imu.csv, calib.yaml, ground truth, meta.yaml;
     with kitti also velodyne/ + times.txt). Returns timing figures."""
     gen = _core.sim.SequenceGenerator(config)

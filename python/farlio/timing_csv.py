@@ -1,5 +1,6 @@
 """timing.csv of a run: one row a frame, built from named fields so that no column can drift from
 the header; written line by line, so a run that dies keeps every row it produced."""
+
 from __future__ import annotations
 
 import csv
@@ -13,10 +14,31 @@ MS_PER_S = 1e3
 NS_PER_MS = NS_PER_S / MS_PER_S
 #: timing.csv's stage_clock: the stage times are wall clock (CPU) or CUDA events (GPU timeline)
 STAGE_CLOCKS = {False: "wall", True: "cuda_events"}
-TIMING_COLUMNS = ["frame", "stamp_ns", "input_points", "kept_points", "source_points", "registered", "converged",
-                  "iterations", "inliers", "sigma_m", "density_limit", "map_voxels", "map_points",
-                  "preprocess_ms", "covariance_ms", "registration_ms", "map_update_ms", "total_ms",
-                  "stage_clock", "fused", "guess_from_fusion", "latency_ms", "drop_reason"]
+TIMING_COLUMNS = [
+    "frame",
+    "stamp_ns",
+    "input_points",
+    "kept_points",
+    "source_points",
+    "registered",
+    "converged",
+    "iterations",
+    "inliers",
+    "sigma_m",
+    "density_limit",
+    "map_voxels",
+    "map_points",
+    "preprocess_ms",
+    "covariance_ms",
+    "registration_ms",
+    "map_update_ms",
+    "total_ms",
+    "stage_clock",
+    "fused",
+    "guess_from_fusion",
+    "latency_ms",
+    "drop_reason",
+]
 
 
 def _ms(seconds: float) -> str:
@@ -30,13 +52,26 @@ def timing_row(index: int, scan: Any, frame: Any) -> dict[str, Any]:
         return {"frame": index, "stamp_ns": scan.end_stamp_ns, "drop_reason": frame.drop_reason}
     r, t = frame.scan, frame.scan.timings
     return {
-        "frame": index, "stamp_ns": r.stamp_ns, "input_points": r.input_points, "kept_points": r.kept_points,
-        "source_points": r.source_points, "registered": int(r.registered), "converged": int(r.converged),
-        "iterations": r.iterations, "inliers": r.inliers, "sigma_m": f"{r.sigma_m:.4f}",
-        "density_limit": r.density_limit, "map_voxels": r.map_voxels, "map_points": r.map_points,
-        "preprocess_ms": _ms(t.preprocess_s), "covariance_ms": _ms(t.covariance_s),
-        "registration_ms": _ms(t.registration_s), "map_update_ms": _ms(t.map_update_s), "total_ms": _ms(t.total_s),
-        "stage_clock": STAGE_CLOCKS[t.device_timed], "fused": int(frame.fused),
+        "frame": index,
+        "stamp_ns": r.stamp_ns,
+        "input_points": r.input_points,
+        "kept_points": r.kept_points,
+        "source_points": r.source_points,
+        "registered": int(r.registered),
+        "converged": int(r.converged),
+        "iterations": r.iterations,
+        "inliers": r.inliers,
+        "sigma_m": f"{r.sigma_m:.4f}",
+        "density_limit": r.density_limit,
+        "map_voxels": r.map_voxels,
+        "map_points": r.map_points,
+        "preprocess_ms": _ms(t.preprocess_s),
+        "covariance_ms": _ms(t.covariance_s),
+        "registration_ms": _ms(t.registration_s),
+        "map_update_ms": _ms(t.map_update_s),
+        "total_ms": _ms(t.total_s),
+        "stage_clock": STAGE_CLOCKS[t.device_timed],
+        "fused": int(frame.fused),
         "guess_from_fusion": int(frame.guess_from_fusion),
         "latency_ms": f"{(frame.available_ns - frame.started_ns) / NS_PER_MS:.3f}",
         "drop_reason": frame.drop_reason,

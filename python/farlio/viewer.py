@@ -1,6 +1,7 @@
 """An optional live 3D view of a run with the `rerun-sdk` package (`farlio run --view`): every
 registered scan in the world frame and the trajectory so far. Without a display the recording is
 saved as run.rrd in the output folder, to open later with `rerun run.rrd`."""
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -18,8 +19,9 @@ def rerun_module() -> Any:
     try:
         import rerun
     except ImportError:
-        raise ValueError("--view needs the 'rerun-sdk' package: pip install rerun-sdk "
-                         "(or run without --view)") from None
+        raise ValueError(
+            "--view needs the 'rerun-sdk' package: pip install rerun-sdk (or run without --view)"
+        ) from None
     return rerun
 
 

@@ -24,12 +24,13 @@ inline Trajectory smooth_curve(std::size_t count, double radius_m = 50.0) {
   constexpr double kAngularRate = 0.01;  // curve parameter per frame
   for (std::size_t k = 0; k < count; ++k) {
     const double s = kAngularRate * static_cast<double>(k);
-    const Eigen::Vector3d p(radius_m * std::sin(s), 0.6 * radius_m * std::sin(2.0 * s), 0.05 * radius_m * std::sin(3.0 * s));
+    const Eigen::Vector3d p(radius_m * std::sin(s), 0.6 * radius_m * std::sin(2.0 * s),
+                            0.05 * radius_m * std::sin(3.0 * s));
     const Eigen::Vector3d tangent(std::cos(s), 1.2 * std::cos(2.0 * s), 0.15 * std::cos(3.0 * s));
     const double yaw = std::atan2(tangent.y(), tangent.x());
     const double pitch = -std::atan2(tangent.z(), tangent.head<2>().norm());
-    const Eigen::Quaterniond q = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
-                                 Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY());
+    const Eigen::Quaterniond q =
+        Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY());
     t.push_back(static_cast<std::int64_t>(k) * kFramePeriod_ns, SE3(q, p));
   }
   return t;

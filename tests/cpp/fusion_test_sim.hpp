@@ -14,21 +14,21 @@ namespace farlio::test {
 struct SimOptions {
   double duration_s = 1.0;
   double imu_hz = 100.0;
-  double clock_hz = 100.0;             ///< advance_to() calls per second
-  double lidar_hz = 10.0;              ///< 0: only the initialising result at t = 0
-  double lidar_delay_s = 0.0;          ///< delivery delay of every LiDAR result after the first
+  double clock_hz = 100.0;     ///< advance_to() calls per second
+  double lidar_hz = 10.0;      ///< 0: only the initialising result at t = 0
+  double lidar_delay_s = 0.0;  ///< delivery delay of every LiDAR result after the first
   double gyro_noise_std_rad_s = 0.0;
   double accel_noise_std_m_s2 = 0.0;
   Eigen::Vector3d gyro_bias_rad_s = Eigen::Vector3d::Zero();
   double lidar_position_noise_m = 0.0;
   double lidar_rotation_noise_rad = 0.0;
   bool accel_in_g = false;
-  double imu_gap_start_s = -1.0;       ///< no IMU samples in [start, start + length)
+  double imu_gap_start_s = -1.0;  ///< no IMU samples in [start, start + length)
   double imu_gap_length_s = 0.0;
-  int outlier_index = -1;              ///< this LiDAR result (1-based after the first) is moved
+  int outlier_index = -1;  ///< this LiDAR result (1-based after the first) is moved
   Eigen::Vector3d outlier_offset_m = Eigen::Vector3d::Zero();
   double outlier_yaw_offset_rad = 0.0;
-  int skip_index = -1;                 ///< this LiDAR result is not delivered at all
+  int skip_index = -1;  ///< this LiDAR result is not delivered at all
   unsigned seed = 42;
 };
 
@@ -46,18 +46,24 @@ struct SimResult {
 
   [[nodiscard]] double max_position_error_m(double from_s = 0.0) const {
     double m = 0.0;
-    for (const auto& s : steps) if (s.t_s >= from_s) m = std::max(m, s.position_error_m.norm());
+    for (const auto& s : steps)
+      if (s.t_s >= from_s) m = std::max(m, s.position_error_m.norm());
     return m;
   }
   [[nodiscard]] double max_rotation_error_deg(double from_s = 0.0) const {
     double m = 0.0;
-    for (const auto& s : steps) if (s.t_s >= from_s) m = std::max(m, s.rotation_error_deg);
+    for (const auto& s : steps)
+      if (s.t_s >= from_s) m = std::max(m, s.rotation_error_deg);
     return m;
   }
   [[nodiscard]] double rms_position_error_m(double from_s = 0.0) const {
     double sum = 0.0;
     int n = 0;
-    for (const auto& s : steps) if (s.t_s >= from_s) { sum += s.position_error_m.squaredNorm(); ++n; }
+    for (const auto& s : steps)
+      if (s.t_s >= from_s) {
+        sum += s.position_error_m.squaredNorm();
+        ++n;
+      }
     return n > 0 ? std::sqrt(sum / n) : 0.0;
   }
   /// The largest change of the position error from one step to the next (a jump of the output).

@@ -48,8 +48,8 @@ struct TestTrajectory {
   }
 
   [[nodiscard]] static Eigen::Matrix3d rotation(const Eigen::Vector3d& rpy) {
-    return (Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) *
-            Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX()))
+    return (Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) *
+            Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) * Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX()))
         .toRotationMatrix();
   }
 
@@ -80,7 +80,9 @@ struct TestTrajectory {
 };
 
 /// Position error in m and rotation error in degrees of an estimate against the truth.
-inline double position_error_m(const SE3& est, const SE3& truth) { return (est.translation() - truth.translation()).norm(); }
+inline double position_error_m(const SE3& est, const SE3& truth) {
+  return (est.translation() - truth.translation()).norm();
+}
 inline double rotation_error_deg(const SE3& est, const SE3& truth) {
   return (truth.inverse() * est).angle_rad() * kDegPerRad;
 }

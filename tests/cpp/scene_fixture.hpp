@@ -17,27 +17,32 @@ inline std::vector<Eigen::Vector3f> sample_scene(std::size_t n, unsigned seed, f
     const float a = u(rng), b = u(rng);
     Eigen::Vector3f p;
     switch (static_cast<int>(u(rng) * 9.0f)) {
-      case 0: case 1: p = {-25 + 50 * a, -25 + 50 * b, 0}; break;                 // floor
-      case 2: p = {-25, -25 + 50 * a, 6 * b}; break;                              // walls
+      case 0:
+      case 1: p = {-25 + 50 * a, -25 + 50 * b, 0}; break;  // floor
+      case 2: p = {-25, -25 + 50 * a, 6 * b}; break;       // walls
       case 3: p = {25, -25 + 50 * a, 6 * b}; break;
       case 4: p = {-25 + 50 * a, 25, 6 * b}; break;
       case 5: p = {-25 + 50 * a, -25, 6 * b}; break;
-      case 6: {                                                                    // two boxes
+      case 6: {  // two boxes
         const bool first = u(rng) < 0.5f;
         const Eigen::Vector3f c = first ? Eigen::Vector3f(5, 3, 0) : Eigen::Vector3f(-8, -6, 0);
         const float side = u(rng);
-        if (side < 0.25f) p = c + Eigen::Vector3f(4 * a, 0, 3 * b);
-        else if (side < 0.5f) p = c + Eigen::Vector3f(4 * a, 4, 3 * b);
-        else if (side < 0.75f) p = c + Eigen::Vector3f(0, 4 * a, 3 * b);
-        else p = c + Eigen::Vector3f(4 * a, 4 * b, 3);
+        if (side < 0.25f)
+          p = c + Eigen::Vector3f(4 * a, 0, 3 * b);
+        else if (side < 0.5f)
+          p = c + Eigen::Vector3f(4 * a, 4, 3 * b);
+        else if (side < 0.75f)
+          p = c + Eigen::Vector3f(0, 4 * a, 3 * b);
+        else
+          p = c + Eigen::Vector3f(4 * a, 4 * b, 3);
         break;
       }
-      case 7: {                                                                    // pole
+      case 7: {  // pole
         const float th = 6.2831853f * a;
         p = {12 + 0.3f * std::cos(th), -12 + 0.3f * std::sin(th), 8 * b};
         break;
       }
-      default: p = {-20 + 15 * a, 10 + 8 * b, 0.25f * 15 * a}; break;             // ramp
+      default: p = {-20 + 15 * a, 10 + 8 * b, 0.25f * 15 * a}; break;  // ramp
     }
     if (noise_m > 0) p += noise_m * Eigen::Vector3f(g(rng), g(rng), g(rng));
     pts.push_back(p);

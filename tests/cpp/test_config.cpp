@@ -100,17 +100,15 @@ TEST_P(ConfigBadValue, IsAnErrorNamingTheFieldAndItsRange) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Fields, ConfigBadValue,
-                         ::testing::Values(BadValue{"fusion.step_s", "0", "in [1e-04, 1]"},
-                                           BadValue{"map.voxel_size_m", "-4", "> 0"},
-                                           BadValue{"map.voxel_size_m", "inf", "> 0"},
-                                           BadValue{"preprocess.min_range_m", "nan", ">= 0"},
-                                           BadValue{"map.covariance_neighbors", "33", "in [1, 32]"},
-                                           BadValue{"registration.max_iterations", "0", ">= 1"},
-                                           BadValue{"fusion.reference_max_sin", "1.5", "in (0, 1]"},
-                                           BadValue{"num_threads", "-2", ">= 0"},
-                                           BadValue{"map.max_voxel_capacity", "0", "in [1, 2147483647]"},
-                                           BadValue{"fusion.gyro_bias_init_x_rad_s", "inf", "finite"}));
+INSTANTIATE_TEST_SUITE_P(
+    Fields, ConfigBadValue,
+    ::testing::Values(BadValue{"fusion.step_s", "0", "in [1e-04, 1]"}, BadValue{"map.voxel_size_m", "-4", "> 0"},
+                      BadValue{"map.voxel_size_m", "inf", "> 0"}, BadValue{"preprocess.min_range_m", "nan", ">= 0"},
+                      BadValue{"map.covariance_neighbors", "33", "in [1, 32]"},
+                      BadValue{"registration.max_iterations", "0", ">= 1"},
+                      BadValue{"fusion.reference_max_sin", "1.5", "in (0, 1]"}, BadValue{"num_threads", "-2", ">= 0"},
+                      BadValue{"map.max_voxel_capacity", "0", "in [1, 2147483647]"},
+                      BadValue{"fusion.gyro_bias_init_x_rad_s", "inf", "finite"}));
 
 TEST(Config, InfinityMeansNoLimitWhereTheRangeSaysSo) {
   Config c;

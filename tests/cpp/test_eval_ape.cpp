@@ -51,7 +51,8 @@ TEST(EvalApe, PositionNoiseGivesSigmaSqrt3) {
   std::mt19937 rng(22);
   std::normal_distribution<double> n(0.0, kSigma_m);
   std::vector<SE3> noisy;
-  for (const auto& p : gt) noisy.push_back(SE3(p.quaternion(), p.translation() + Eigen::Vector3d(n(rng), n(rng), n(rng))));
+  for (const auto& p : gt)
+    noisy.push_back(SE3(p.quaternion(), p.translation() + Eigen::Vector3d(n(rng), n(rng), n(rng))));
   const ApeResult r = compute_ape(noisy, gt);
   // E|e|^2 = 3 sigma^2; with 20000 samples the RMSE is within ~0.5 % of sigma*sqrt(3).
   EXPECT_NEAR(r.translation_m.rmse, kSigma_m * std::sqrt(3.0), 0.02 * kSigma_m * std::sqrt(3.0));

@@ -101,7 +101,8 @@ TEST(EvalDeltaRpe, ErrorIsTheRelativeTransformOfRelativeMotions) {
   double sum_sq = 0.0;
   for (std::size_t n = 0; n < r.pairs.size(); ++n) {
     const auto [i, j] = r.pairs[n];
-    const Mat4d E = (gt[i].matrix().inverse() * gt[j].matrix()).inverse() * (est[i].matrix().inverse() * est[j].matrix());
+    const Mat4d E =
+        (gt[i].matrix().inverse() * gt[j].matrix()).inverse() * (est[i].matrix().inverse() * est[j].matrix());
     const double expected_m = E.block<3, 1>(0, 3).norm();
     EXPECT_NEAR(r.translation_errors_m[n], expected_m, 1e-9);
     sum_sq += E.block<3, 1>(0, 3).squaredNorm();

@@ -25,9 +25,8 @@ TEST(EvalKittiRpe, IdenticalTrajectoriesGiveZero) {
 
 TEST(EvalKittiRpe, ScaledMotionGivesExactlyOnePercent) {
   const Trajectory line = test::straight_line(2001, kStep_m);  // 1000 m: the KITTI lengths apply
-  const Trajectory est = test::with_modified_increments(line, [](const SE3& d) {
-    return SE3(d.quaternion(), 1.01 * d.translation());
-  });
+  const Trajectory est =
+      test::with_modified_increments(line, [](const SE3& d) { return SE3(d.quaternion(), 1.01 * d.translation()); });
   const KittiRpeResult r = compute_kitti_rpe(test::poses_of(est), test::poses_of(line));
   EXPECT_EQ(r.segment_lengths_m, kitti_segment_lengths_m());
   EXPECT_NEAR(r.translation_pct, 1.0, 1e-9);
@@ -89,7 +88,8 @@ TEST(EvalKittiRpe, MatchesBruteForceOnRandomWalk) {
         ++j;
       }
       if (d < L) continue;
-      const Mat4d E = (gt[i].matrix().inverse() * gt[j].matrix()).inverse() * (est[i].matrix().inverse() * est[j].matrix());
+      const Mat4d E =
+          (gt[i].matrix().inverse() * gt[j].matrix()).inverse() * (est[i].matrix().inverse() * est[j].matrix());
       t_sum += E.block<3, 1>(0, 3).norm() / L;
       const double c = std::clamp(0.5 * (E.block<3, 3>(0, 0).trace() - 1.0), -1.0, 1.0);
       r_sum += std::acos(c) / L;

@@ -12,8 +12,8 @@ using namespace farlio;
 using namespace farlio::fusion;
 
 namespace {
-constexpr double kDiffStep = 1e-6;       // central-difference step
-constexpr double kJacobianTol = 1e-5;    // absolute tolerance of a Jacobian entry
+constexpr double kDiffStep = 1e-6;     // central-difference step
+constexpr double kJacobianTol = 1e-5;  // absolute tolerance of a Jacobian entry
 constexpr int kRandomCases = 50;
 
 StateVector true_state(const test::TestTrajectory& traj, double t) {
@@ -46,7 +46,8 @@ TEST(FusionModel, DerivativeMatchesAnalyticTrajectory) {
   for (double t : {0.0, 0.37, 1.2, 2.9}) {
     const StateVector f = state_derivative(true_state(traj, t), true_input(traj, t), test::kGravity_m_s2);
     const StateVector numeric = (true_state(traj, t + kDiffStep) - true_state(traj, t - kDiffStep)) / (2 * kDiffStep);
-    EXPECT_LT((f - numeric).norm(), 1e-5 * (1.0 + numeric.norm())) << "t=" << t << "\n" << f.transpose() << "\n"
+    EXPECT_LT((f - numeric).norm(), 1e-5 * (1.0 + numeric.norm())) << "t=" << t << "\n"
+                                                                   << f.transpose() << "\n"
                                                                    << numeric.transpose();
   }
 }
@@ -67,15 +68,17 @@ TEST(FusionModel, JacobiansMatchCentralDifferences) {
     for (int i = 0; i < kStateDim; ++i) {
       StateVector d = StateVector::Zero();
       d(i) = kDiffStep;
-      dfdx.col(i) = (state_derivative(x + d, u, test::kGravity_m_s2) - state_derivative(x - d, u, test::kGravity_m_s2)) /
-                    (2 * kDiffStep);
+      dfdx.col(i) =
+          (state_derivative(x + d, u, test::kGravity_m_s2) - state_derivative(x - d, u, test::kGravity_m_s2)) /
+          (2 * kDiffStep);
     }
     InputMatrix dfdu;
     for (int i = 0; i < kInputDim; ++i) {
       InputVector d = InputVector::Zero();
       d(i) = kDiffStep;
-      dfdu.col(i) = (state_derivative(x, u + d, test::kGravity_m_s2) - state_derivative(x, u - d, test::kGravity_m_s2)) /
-                    (2 * kDiffStep);
+      dfdu.col(i) =
+          (state_derivative(x, u + d, test::kGravity_m_s2) - state_derivative(x, u - d, test::kGravity_m_s2)) /
+          (2 * kDiffStep);
     }
     const double scale = 1.0 + dfdx.cwiseAbs().maxCoeff();
     EXPECT_LT((J.df_dx - dfdx).cwiseAbs().maxCoeff(), kJacobianTol * scale) << "case " << c << "\n" << J.df_dx - dfdx;

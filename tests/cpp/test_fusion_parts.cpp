@@ -28,8 +28,8 @@ TEST(FusionParts, ReferenceAnglesRecoverTrueRollAndPitchOnAFastCurve) {
     ++produced;
     const Eigen::Vector3d truth = traj.rpy(ns_to_seconds(a->stamp_ns));
     EXPECT_FALSE(a->saturated);
-    max_err_deg = std::max({max_err_deg, std::abs(a->roll_rad - truth.x()) * kDegPerRad,
-                            std::abs(a->pitch_rad - truth.y()) * kDegPerRad});
+    max_err_deg = std::max(
+        {max_err_deg, std::abs(a->roll_rad - truth.x()) * kDegPerRad, std::abs(a->pitch_rad - truth.y()) * kDegPerRad});
   }
   EXPECT_EQ(produced, 300 - 12);  // the window needs taps + 2 samples
   EXPECT_LT(max_err_deg, 0.05);
@@ -99,7 +99,8 @@ TEST(FusionParts, EkfUpdateGatesWrapsAndStaysSymmetric) {
   ekf.initialize(x, StateMatrix::Identity() * 0.01);
   // A yaw measurement at -3.1 is 0.083 rad away across the wrap, not 6.2 rad.
   const Eigen::Vector3d z(0.0, 0.0, -3.1);
-  const Eigen::VectorXd r = measurement_difference(MeasurementKind::kOrientation, z, measure(MeasurementKind::kOrientation, x));
+  const Eigen::VectorXd r =
+      measurement_difference(MeasurementKind::kOrientation, z, measure(MeasurementKind::kOrientation, x));
   EXPECT_NEAR(r(2), 2.0 * std::numbers::pi - 6.2, 1e-12);
   const Eigen::Matrix3d R = Eigen::Matrix3d::Identity() * 0.01;
   EXPECT_TRUE(ekf.update(MeasurementKind::kOrientation, r, R, 16.27));

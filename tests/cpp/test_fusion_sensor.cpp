@@ -35,7 +35,7 @@ FusionConfig matched_config() {
   c.lidar_position_std_m = 0.02;
   c.lidar_roll_pitch_std_rad = 0.1 / kDegPerRad;
   c.lidar_yaw_std_rad = 0.1 / kDegPerRad;
-  c.accel_input_std_m_s2 = 0.1;  // 2x the simulated accelerometer noise
+  c.accel_input_std_m_s2 = 0.1;   // 2x the simulated accelerometer noise
   c.gyro_input_std_rad_s = 0.01;  // 2x the simulated gyro noise (the bias is not modelled)
   return c;
 }
@@ -112,7 +112,8 @@ TEST(FusionSensor, OutlierPoseLeavesTheEstimateUnchanged) {
   ASSERT_EQ(with_outlier.steps.size(), without.steps.size());
   double max_diff_m = 0.0;
   for (std::size_t i = 0; i < without.steps.size(); ++i) {
-    max_diff_m = std::max(max_diff_m, (with_outlier.steps[i].position_error_m - without.steps[i].position_error_m).norm());
+    max_diff_m =
+        std::max(max_diff_m, (with_outlier.steps[i].position_error_m - without.steps[i].position_error_m).norm());
   }
   EXPECT_LT(max_diff_m, 1e-9);
   EXPECT_LT(with_outlier.max_position_error_m(), 0.10);
@@ -136,10 +137,11 @@ TEST(FusionSensor, DelayCompensationMatchesTheUndelayedRun) {
     return std::sqrt(sum / static_cast<double>(a.steps.size()));
   };
   const double d_on = rms_diff(compensated), d_off = rms_diff(uncompensated);
-  std::printf("50 ms delay: rms distance to the undelayed run %.4f m compensated, %.4f m uncompensated; "
-              "rms error %.4f / %.4f / %.4f m (undelayed / compensated / not)\n",
-              d_on, d_off, undelayed.rms_position_error_m(), compensated.rms_position_error_m(),
-              uncompensated.rms_position_error_m());
+  std::printf(
+      "50 ms delay: rms distance to the undelayed run %.4f m compensated, %.4f m uncompensated; "
+      "rms error %.4f / %.4f / %.4f m (undelayed / compensated / not)\n",
+      d_on, d_off, undelayed.rms_position_error_m(), compensated.rms_position_error_m(),
+      uncompensated.rms_position_error_m());
   // Measured: 0.039 m vs 3.13 m; rms error after 1 s 0.018 / 0.025 / 3.1 m. The compensated run
   // is close to the undelayed one (its corrections are simply 50 ms later); without
   // compensation every result is treated as current and the estimate lags by ~1.5 m at 30 m/s.
@@ -171,7 +173,7 @@ TEST(FusionSensor, ImuGapIsBridgedAndCounted) {
   ASSERT_TRUE(r.finite);
   EXPECT_EQ(r.stats.imu_gaps, 1);
   EXPECT_FALSE(r.stats.last_warning.empty());
-  EXPECT_LT(r.max_position_error_m(), 0.5);   // during the gap: held input, LiDAR still fused
+  EXPECT_LT(r.max_position_error_m(), 0.5);      // during the gap: held input, LiDAR still fused
   EXPECT_LT(r.max_position_error_m(6.5), 0.10);  // recovered
   std::printf("IMU gap: max position error %.3f m overall, %.3f m after 6.5 s\n", r.max_position_error_m(),
               r.max_position_error_m(6.5));

@@ -36,7 +36,8 @@ struct Problem {
     if (sparse_source) {  // dense on the left half, a few isolated floor points on the right
       std::erase_if(src_world, [](const Eigen::Vector3f& p) { return p.x() > 0.0f; });
       for (int i = 0; i < 40; ++i) {
-        src_world.emplace_back(10.0f + 0.35f * static_cast<float>(i % 5 * 8), -24.0f + 1.2f * static_cast<float>(i), 0.0f);
+        src_world.emplace_back(10.0f + 0.35f * static_cast<float>(i % 5 * 8), -24.0f + 1.2f * static_cast<float>(i),
+                               0.0f);
       }
     }
     std::vector<Eigen::Vector3f> src_sensor;
@@ -69,7 +70,8 @@ TEST_P(GicpRecovers, KnownTransformFromPerturbedStart) {
   const SE3 guess = pb.truth * SE3::exp(d);
   ASSERT_GT(pb.source.size(), 1000u);
   RegistrationConfig cfg;
-  const auto res = register_scan(pb.source, pb.target.view(), guess, Thresholds::from_sigma(1.0), cfg, kNoBudget, pb.ex);
+  const auto res =
+      register_scan(pb.source, pb.target.view(), guess, Thresholds::from_sigma(1.0), cfg, kNoBudget, pb.ex);
   EXPECT_TRUE(res.converged);
   EXPECT_LT(trans_err(res.pose, pb.truth), 0.02) << "iterations " << res.iterations;
   EXPECT_LT(rot_err_deg(res.pose, pb.truth), 0.1);
@@ -96,9 +98,9 @@ TEST(Gicp, PointToPointFallbackWithoutCovariance) {
   ASSERT_TRUE(gicp_factor(target.view(), with_cov, c, fp, f_cov));
   ASSERT_TRUE(gicp_factor(target.view(), without, c, fp, f_p2p));
   // point-to-point: the translation block of H is w * I (kernel weight ~1 with a huge kappa)
-  EXPECT_NEAR(f_p2p.H[0], 1.0f, 1e-4f);   // H(0,0)
-  EXPECT_NEAR(f_p2p.H[1], 0.0f, 1e-6f);   // H(0,1)
-  EXPECT_NEAR(f_p2p.H[6], 1.0f, 1e-4f);   // H(1,1)
+  EXPECT_NEAR(f_p2p.H[0], 1.0f, 1e-4f);  // H(0,0)
+  EXPECT_NEAR(f_p2p.H[1], 0.0f, 1e-6f);  // H(0,1)
+  EXPECT_NEAR(f_p2p.H[6], 1.0f, 1e-4f);  // H(1,1)
   // GICP on the floor: the normal direction (z) dominates the information
   EXPECT_GT(f_cov.H[15], 10.0f * f_cov.H[0]);  // H(2,2) >> H(0,0)
   // and with the sparsity-aware switch off, the valid covariance is ignored too
@@ -175,8 +177,8 @@ TEST(Gicp, PairsOfLineLikeCovariancesAreLeftOut) {
 TEST(Gicp, TimeBudgetStopsIt) {
   Problem pb(make_pose(0, 0, 0, 0));
   const SE3 guess = make_pose(0.5, 0.3, 0.0, 4.0);
-  const auto res = register_scan(pb.source, pb.target.view(), guess, Thresholds::from_sigma(1.0), RegistrationConfig{},
-                                 0.0, pb.ex);
+  const auto res =
+      register_scan(pb.source, pb.target.view(), guess, Thresholds::from_sigma(1.0), RegistrationConfig{}, 0.0, pb.ex);
   EXPECT_EQ(res.iterations, 1);
   EXPECT_TRUE(res.budget_exceeded);
   EXPECT_FALSE(res.converged);

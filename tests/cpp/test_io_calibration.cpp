@@ -21,9 +21,7 @@ const std::string kIdentityRows = "    - [1, 0, 0, 0]\n    - [0, 1, 0, 0]\n    -
 
 SE3 pose(double x, double yaw) { return SE3(so3_exp(Eigen::Vector3d(0.1, -0.2, yaw)), Eigen::Vector3d(x, 0.5, -0.25)); }
 
-void expect_same(const SE3& a, const SE3& b) {
-  EXPECT_LT((a.matrix() - b.matrix()).cwiseAbs().maxCoeff(), kExact);
-}
+void expect_same(const SE3& a, const SE3& b) { EXPECT_LT((a.matrix() - b.matrix()).cwiseAbs().maxCoeff(), kExact); }
 
 }  // namespace
 
@@ -98,8 +96,11 @@ TEST(Calibration, UnknownLidarNamesTheFileAndTheEntries) {
   const auto p = tmp.path() / "multi.yaml";
   test::write_raw(p, "T_imu_lidar:\n  /front:\n" + kIdentityRows + "  /rear:\n" + kIdentityRows);
   const Calibration c = read_calibration(p);
-  test::expect_input_error([&] { (void)c.lidar_extrinsic({"/top", "top_frame"}); }, p,
-                           "no entry for '/top' or 'top_frame' (entries: /front, /rear)");
+  test::expect_input_error(
+      [&] {
+        (void)c.lidar_extrinsic({"/top", "top_frame"});
+      },
+      p, "no entry for '/top' or 'top_frame' (entries: /front, /rear)");
 }
 
 TEST(Calibration, BadInputNamesFileAndKey) {
@@ -125,8 +126,10 @@ TEST(Calibration, BadInputNamesFileAndKey) {
                "key 'T_imu_lidar[/front]': expected a 4x4 matrix");
   expect_error("T_imu_lidar:\n  /front: [[0, 1, 0, 0], [1, 0, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]\n",
                "key 'T_imu_lidar[/front]': not a rigid transform");
-  expect_error("T_imu_lidar:\n  /front:\n" + kIdentityRows + "  /rear: [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], "
-               "[0, 0, 0, y]]\n", "T_imu_lidar[/rear][3][3]");
+  expect_error("T_imu_lidar:\n  /front:\n" + kIdentityRows +
+                   "  /rear: [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], "
+                   "[0, 0, 0, y]]\n",
+               "T_imu_lidar[/rear][3][3]");
   expect_error("T_imu_lidar:\n  ? [a, b]\n  : [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]\n",
                "not a LiDAR topic or frame id");
   test::expect_input_error([&] { (void)read_calibration(tmp.path() / "none.yaml"); }, tmp.path() / "none.yaml",

@@ -84,7 +84,8 @@ TEST(Pcd, ShuffledFieldsExtraFieldsAndOusterTime) {
   std::string bin = header(fields, size, type, count, n, "binary");
   std::string ascii = header(fields, size, type, count, n, "ascii");
   for (std::size_t i = 0; i < n; ++i) {
-    const float x = 1.5f + static_cast<float>(i), y = -2.25f, z = 0.125f * static_cast<float>(i), in = 10.0f * static_cast<float>(i);
+    const float x = 1.5f + static_cast<float>(i), y = -2.25f, z = 0.125f * static_cast<float>(i),
+                in = 10.0f * static_cast<float>(i);
     const std::uint32_t t_ns = 25'000'000u * static_cast<std::uint32_t>(i);
     test::append_binary<std::uint16_t>(bin, static_cast<std::uint16_t>(i));
     for (int k = 0; k < 3; ++k) test::append_binary<float>(bin, 9.0f);
@@ -118,10 +119,10 @@ TEST(Pcd, BinaryCompressedWithExtraFieldsIsStructureOfArrays) {
   TempDir tmp;
   const std::size_t n = 4;
   std::string soa;
-  for (std::size_t i = 0; i < n; ++i) test::append_binary<float>(soa, 10.0f + static_cast<float>(i));  // y
-  for (std::size_t i = 0; i < n; ++i) test::append_binary<float>(soa, static_cast<float>(i));          // x
-  for (std::size_t i = 0; i < 3 * n; ++i) test::append_binary<float>(soa, -1.0f);                      // normal
-  for (std::size_t i = 0; i < n; ++i) test::append_binary<double>(soa, 0.01 * static_cast<double>(i)); // time
+  for (std::size_t i = 0; i < n; ++i) test::append_binary<float>(soa, 10.0f + static_cast<float>(i));   // y
+  for (std::size_t i = 0; i < n; ++i) test::append_binary<float>(soa, static_cast<float>(i));           // x
+  for (std::size_t i = 0; i < 3 * n; ++i) test::append_binary<float>(soa, -1.0f);                       // normal
+  for (std::size_t i = 0; i < n; ++i) test::append_binary<double>(soa, 0.01 * static_cast<double>(i));  // time
   std::string z_block;
   for (std::size_t i = 0; i < n; ++i) test::append_binary<float>(z_block, 5.0f);
   soa.insert(4 * n * 2, z_block);  // z after x
@@ -215,13 +216,15 @@ TEST(Pcd, MalformedHeadersThrow) {
       {"badtype.pcd", "FIELDS x y z\nSIZE 4 4 4\nTYPE F F Q\nWIDTH 0\nHEIGHT 1\nPOINTS 0\nDATA ascii\n", "TYPE"},
       {"badsize.pcd", "FIELDS x y z\nSIZE 4 4 3\nTYPE F F F\nWIDTH 0\nHEIGHT 1\nPOINTS 0\nDATA ascii\n", "SIZE 3"},
       {"points.pcd", "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 5\nHEIGHT 1\nPOINTS 4\nDATA ascii\n", "POINTS"},
-      {"unknownkey.pcd", "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOLOR 1\nWIDTH 0\nHEIGHT 1\nPOINTS 0\nDATA ascii\n", "COLOR"},
+      {"unknownkey.pcd", "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOLOR 1\nWIDTH 0\nHEIGHT 1\nPOINTS 0\nDATA ascii\n",
+       "COLOR"},
       {"encoding.pcd", "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 0\nHEIGHT 1\nPOINTS 0\nDATA zip\n", "zip"},
       {"noz.pcd", "FIELDS x y w\nSIZE 4 4 4\nTYPE F F F\nWIDTH 0\nHEIGHT 1\nPOINTS 0\nDATA ascii\n", "'z'"},
-      {"wrongpoints.pcd", "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 3\nHEIGHT 1\nPOINTS 3\nDATA ascii\n1 2 3\n4 5 6\n",
+      {"wrongpoints.pcd",
+       "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 3\nHEIGHT 1\nPOINTS 3\nDATA ascii\n1 2 3\n4 5 6\n",
        "header says 3 points but data holds 2"},
-      {"extrapoint.pcd", "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA ascii\n1 2 3\n4 5 6\n",
-       "another"},
+      {"extrapoint.pcd",
+       "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA ascii\n1 2 3\n4 5 6\n", "another"},
       {"nan_text.pcd", "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA ascii\n1 two 3\n",
        "'two'"},
       {"short_line.pcd", "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA ascii\n1 2\n",

@@ -127,12 +127,15 @@ TEST(Ply, TruncatedAndMalformedThrow) {
       {"noend.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"},
       {"novertex.ply", "ply\nformat ascii 1.0\nelement face 0\nproperty list uchar int v\nend_header\n"},
       {"noz.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nend_header\n1 2\n"},
-      {"short.ply", "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\n"
-                    "end_header\n1 2 3\n4 5\n"},
-      {"text.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
-                   "end_header\n1 b 3\n"},
-      {"extra.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
-                    "end_header\n1 2 3 4\n"},
+      {"short.ply",
+       "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\n"
+       "end_header\n1 2 3\n4 5\n"},
+      {"text.ply",
+       "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+       "end_header\n1 b 3\n"},
+      {"extra.ply",
+       "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+       "end_header\n1 2 3 4\n"},
   };
   for (const auto& [name, text] : cases) {
     SCOPED_TRACE(name);

@@ -51,13 +51,15 @@ TEST(Sequence, WriteReadRoundTrip) {
   std::vector<Scan> scans;
   Trajectory gt_scans, lidar_poses;
   // Irregular periods: the start stamps must follow the previous end stamp.
-  const std::vector<std::int64_t> ends = {kT0_ns, kT0_ns + kPeriod_ns, kT0_ns + 2 * kPeriod_ns + 3, kT0_ns + 3 * kPeriod_ns};
+  const std::vector<std::int64_t> ends = {kT0_ns, kT0_ns + kPeriod_ns, kT0_ns + 2 * kPeriod_ns + 3,
+                                          kT0_ns + 3 * kPeriod_ns};
   for (std::size_t i = 0; i < ends.size(); ++i) {
     Scan s = test::random_scan(300 + i, static_cast<unsigned>(i));
     s.end_stamp_ns = ends[i];
     w.write_scan(s, i % 2 ? PcdEncoding::BinaryCompressed : PcdEncoding::Binary);
     scans.push_back(s);
-    const SE3 pose = SE3::exp((Vec6d() << 1.0 * static_cast<double>(i), 0, 0, 0, 0, 0.1 * static_cast<double>(i)).finished());
+    const SE3 pose =
+        SE3::exp((Vec6d() << 1.0 * static_cast<double>(i), 0, 0, 0, 0, 0.1 * static_cast<double>(i)).finished());
     gt_scans.push_back(ends[i], pose);
     lidar_poses.push_back(ends[i], pose * calib.T_imu_lidar);
   }
@@ -155,7 +157,8 @@ TEST(Sequence, ImuBackwardsSampleDroppedWithWarning) {
   const auto warn = r.warnings();
   ASSERT_EQ(warn.size(), 2u);  // the unknown column and the dropped sample
   bool found = false;
-  for (const auto& m : warn) found = found || (m.find("imu.csv:4") != std::string::npos && m.find("dropped") != std::string::npos);
+  for (const auto& m : warn)
+    found = found || (m.find("imu.csv:4") != std::string::npos && m.find("dropped") != std::string::npos);
   EXPECT_TRUE(found);
 }
 
@@ -186,19 +189,23 @@ TEST(Sequence, BadFoldersThrow) {
   test::expect_input_error([&] { SequenceReader r(d); }, d / "imu.csv", "imu.csv:2");
   test::write_raw(d / "imu.csv", "t_ns,gx,gy,gz,ax,ay,az\n");
 
-  test::write_raw(d / "calib.yaml", "T_imu_lidar:\n  - [1, 0, 0]\n  - [0, 1, 0, 0]\n  - [0, 0, 1, 0]\n  - [0, 0, 0, 1]\n");
+  test::write_raw(d / "calib.yaml",
+                  "T_imu_lidar:\n  - [1, 0, 0]\n  - [0, 1, 0, 0]\n  - [0, 0, 1, 0]\n  - [0, 0, 0, 1]\n");
   test::expect_input_error([&] { SequenceReader r(d); }, d / "calib.yaml", "T_imu_lidar");
-  test::write_raw(d / "calib.yaml", "T_imu_lidar:\n  - [2, 0, 0, 0]\n  - [0, 1, 0, 0]\n  - [0, 0, 1, 0]\n  - [0, 0, 0, 1]\n");
+  test::write_raw(d / "calib.yaml",
+                  "T_imu_lidar:\n  - [2, 0, 0, 0]\n  - [0, 1, 0, 0]\n  - [0, 0, 1, 0]\n  - [0, 0, 0, 1]\n");
   test::expect_input_error([&] { SequenceReader r(d); }, d / "calib.yaml", "rotation");
   test::write_raw(d / "calib.yaml", "gravity: 9.81\n");
   test::expect_input_error([&] { SequenceReader r(d); }, d / "calib.yaml", "T_imu_lidar");
   test::write_raw(d / "calib.yaml", "T_imu_lidar: [unclosed\n");
   test::expect_input_error([&] { SequenceReader r(d); }, d / "calib.yaml", "YAML");
-  test::write_raw(d / "calib.yaml",
-                  "T_imu_lidar:\n  - [1, 0, 0, 0]\n  - [0, 1, 0, 0]\n  - [0, 0, 1, 0]\n  - [0, 0, 0, 1]\ngravity: abc\n");
+  test::write_raw(
+      d / "calib.yaml",
+      "T_imu_lidar:\n  - [1, 0, 0, 0]\n  - [0, 1, 0, 0]\n  - [0, 0, 1, 0]\n  - [0, 0, 0, 1]\ngravity: abc\n");
   test::expect_input_error([&] { SequenceReader r(d); }, d / "calib.yaml", "gravity");
-  test::write_raw(d / "calib.yaml",
-                  "T_imu_lidar:\n  - [1, 0, 0, 0]\n  - [0, 1, 0, 0]\n  - [0, 0, 1, 0]\n  - [0, 0, 0, 1]\nextra: {a: 1}\n");
+  test::write_raw(
+      d / "calib.yaml",
+      "T_imu_lidar:\n  - [1, 0, 0, 0]\n  - [0, 1, 0, 0]\n  - [0, 0, 1, 0]\n  - [0, 0, 0, 1]\nextra: {a: 1}\n");
   SequenceReader ok(d);  // extra keys are ignored
   EXPECT_FALSE(ok.calibration().gravity_m_s2.has_value());
   EXPECT_EQ(ok.calibration().gravity_or_default(), kDefaultGravity_m_s2);

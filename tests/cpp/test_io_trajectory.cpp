@@ -43,8 +43,8 @@ void expect_same(const Trajectory& a, const Trajectory& b, bool stamps) {
 }  // namespace
 
 TEST(TextNumber, SecondsNsExactConversion) {
-  for (std::int64_t ns : {std::int64_t{0}, std::int64_t{1}, std::int64_t{999'999'999}, std::int64_t{1'700'000'000'123'456'789},
-                          std::int64_t{-1'500'000'001}, std::int64_t{-1}}) {
+  for (std::int64_t ns : {std::int64_t{0}, std::int64_t{1}, std::int64_t{999'999'999},
+                          std::int64_t{1'700'000'000'123'456'789}, std::int64_t{-1'500'000'001}, std::int64_t{-1}}) {
     const std::string s = format_seconds_from_ns(ns);
     EXPECT_EQ(s.size() - s.find('.') - 1, 9u) << s;
     EXPECT_EQ(parse_seconds_to_ns(s), ns) << s;
@@ -69,7 +69,8 @@ TEST(Tum, RoundTripWithLargeStamps) {
 TEST(Tum, CommentsBlankLinesAndErrorsWithLineNumbers) {
   TempDir tmp;
   const auto p = tmp.path() / "b.tum";
-  test::write_raw(p, "# header\n\n1.0 1 2 3 0 0 0 1\n  # indented comment\n2.5 4 5 6 0 0 0.7071067811865476 0.7071067811865476\n");
+  test::write_raw(
+      p, "# header\n\n1.0 1 2 3 0 0 0 1\n  # indented comment\n2.5 4 5 6 0 0 0.7071067811865476 0.7071067811865476\n");
   const auto tr = read_tum(p);
   ASSERT_EQ(tr.size(), 2u);
   EXPECT_EQ(tr[1].stamp_ns, 2'500'000'000);
@@ -92,7 +93,8 @@ TEST(Kitti, RoundTripAndStamps) {
   write_kitti(p, tr);
   const auto plain = read_kitti(p);
   expect_same(tr, plain, false);
-  for (std::size_t i = 0; i < plain.size(); ++i) EXPECT_EQ(plain[i].stamp_ns, static_cast<std::int64_t>(i) * kKittiDefaultPeriodNs);
+  for (std::size_t i = 0; i < plain.size(); ++i)
+    EXPECT_EQ(plain[i].stamp_ns, static_cast<std::int64_t>(i) * kKittiDefaultPeriodNs);
   std::vector<std::int64_t> stamps;
   for (const auto& sp : tr) stamps.push_back(sp.stamp_ns);
   expect_same(tr, read_kitti(p, &stamps), true);

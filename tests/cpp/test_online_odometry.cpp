@@ -4,9 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
-#include <limits>
 #include <chrono>
 #include <condition_variable>
+#include <limits>
 #include <mutex>
 #include <thread>
 
@@ -26,7 +26,7 @@ struct Recording {
   double gravity_m_s2 = 0;
 };
 
-constexpr double kSeconds = 1.5;  // 15 scans: enough for the LIO to run, short under sanitizers
+constexpr double kSeconds = 1.5;       // 15 scans: enough for the LIO to run, short under sanitizers
 constexpr std::size_t kKeepEvery = 4;  // every 4th point (~30k per scan) keeps sanitizer runs short
 
 /// Every k-th point of a scan with its time, intensity and sensor id.

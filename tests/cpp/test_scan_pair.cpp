@@ -67,5 +67,6 @@ TEST_P(ScanPair, RegistersFromPerturbedStarts) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Voxels, ScanPair, ::testing::Values(PairCase{4.0, false, 0.035, 0.4}, PairCase{2.0, false, 0.02, 0.3},
-                                                              PairCase{2.0, true, 0.02, 0.2}));
+INSTANTIATE_TEST_SUITE_P(Voxels, ScanPair,
+                         ::testing::Values(PairCase{4.0, false, 0.035, 0.4}, PairCase{2.0, false, 0.02, 0.3},
+                                           PairCase{2.0, true, 0.02, 0.2}));

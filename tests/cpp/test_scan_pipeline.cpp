@@ -55,7 +55,8 @@ TEST(ScanPipeline, TracksAKnownTrajectory) {
   const auto last = p.process(make_scan(25, period));
   const Eigen::Vector3d v_world = last.pose.rotation() * last.velocity_body_m_s;
   EXPECT_NEAR(v_world.x(), 1.5, 0.3);
-  EXPECT_LE(p.backend().map_points(), p.backend().map_voxels() * static_cast<std::size_t>(cfg.map.max_points_per_voxel));
+  EXPECT_LE(p.backend().map_points(),
+            p.backend().map_voxels() * static_cast<std::size_t>(cfg.map.max_points_per_voxel));
 }
 
 TEST(ScanPipeline, EmptyAndDegenerateScansDoNotCrash) {

@@ -43,14 +43,23 @@ TEST(SharedBodies, VoxelGroupInsertionKeepsOrderCapAndSpacing) {
   constexpr int kMax = 3;
   std::vector<Eigen::Vector4f> points(kMax, Eigen::Vector4f::Zero());
   std::vector<map::Cov3> covs(kMax);
-  map::MapView m{slot_keys.data(), slot_voxels.data(), 16, voxel_keys.data(), counts.data(), points.data(),
-                 covs.data(),      kMax,               4.0f, 0.25f};
-  const std::vector<Eigen::Vector3f> cand = {{0.5f, 0.5f, 0.5f}, {0.9f, 0.5f, 0.5f}, {2.0f, 0.5f, 0.5f},
-                                             {3.5f, 0.5f, 0.5f}, {0.5f, 3.5f, 0.5f}};
+  map::MapView m{slot_keys.data(),
+                 slot_voxels.data(),
+                 16,
+                 voxel_keys.data(),
+                 counts.data(),
+                 points.data(),
+                 covs.data(),
+                 kMax,
+                 4.0f,
+                 0.25f};
+  const std::vector<Eigen::Vector3f> cand = {
+      {0.5f, 0.5f, 0.5f}, {0.9f, 0.5f, 0.5f}, {2.0f, 0.5f, 0.5f}, {3.5f, 0.5f, 0.5f}, {0.5f, 3.5f, 0.5f}};
   const map::InsertParams ip{Eigen::Vector3f::Zero(), map::PointLimit::constant(kMax), 1.0f};
   std::int32_t first_new = -1;
-  const auto s = map::insert_voxel_group(m, 0, [&](std::int64_t c) { return cand[static_cast<std::size_t>(c)]; }, 0,
-                                         static_cast<std::int64_t>(cand.size()), ip, &first_new);
+  const auto s = map::insert_voxel_group(
+      m, 0, [&](std::int64_t c) { return cand[static_cast<std::size_t>(c)]; }, 0,
+      static_cast<std::int64_t>(cand.size()), ip, &first_new);
   EXPECT_EQ(first_new, 0);
   EXPECT_EQ(s.inserted, 3);
   EXPECT_EQ(s.spacing, 1);  // (0.9, 0.5, 0.5) is 0.4 m from the first
@@ -77,7 +86,8 @@ TEST(SharedBodies, FactorSumsReduceToTheSameSystemAsPerPointSums) {
   // serial sum of the same per-point bodies
   const auto fp = registration::factor_params(T, th, RegistrationConfig{});
   auto serial = registration::FactorSums::zero();
-  for (std::size_t i = 0; i < src.size(); ++i) serial += registration::factor_sums(target.view(), src.points[i], src.covs[i], fp);
+  for (std::size_t i = 0; i < src.size(); ++i)
+    serial += registration::factor_sums(target.view(), src.points[i], src.covs[i], fp);
   const auto ref = registration::to_linear_system(serial);
   EXPECT_EQ(sys.inliers, ref.inliers);
   EXPECT_GT(sys.inliers, 0);

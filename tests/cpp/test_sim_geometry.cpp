@@ -46,7 +46,8 @@ TEST(SimPath, RoundedRectanglePassesNearItsVerticesAndCloses) {
   EXPECT_LT(path.length_m(), 400.0);
   EXPECT_GT(path.length_m(), 400.0 - 4 * 2 * 10.0 * 1.5);
   // An edge too short for its corners is rejected.
-  EXPECT_THROW(Path::from_polyline({{0, 0}, {10, 0}, {10, 10}, {0, 10}}, {10, 10, 10, 10}, true), std::invalid_argument);
+  EXPECT_THROW(Path::from_polyline({{0, 0}, {10, 0}, {10, 10}, {0, 10}}, {10, 10, 10, 10}, true),
+               std::invalid_argument);
 }
 
 TEST(SimPrimitives, BoxCylinderGroundAgainstAnalyticHits) {

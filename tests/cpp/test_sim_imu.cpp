@@ -80,7 +80,8 @@ void check_profile(Profile profile, double search_s, const std::vector<double>& 
     const BodyState end = gen.state(imu[k0 + n].stamp_ns);
     const Integrated x = integrate(imu, k0, n, start, gen.gravity_m_s2());
     const double pos_err = (x.p - end.pose_world_body.translation()).norm();
-    const double rot_err_deg = so3_log(x.R.transpose() * end.pose_world_body.rotation()).norm() * 180.0 / std::numbers::pi;
+    const double rot_err_deg =
+        so3_log(x.R.transpose() * end.pose_world_body.rotation()).norm() * 180.0 / std::numbers::pi;
     // The motion over the horizon is far larger than the tolerance, so a wrong reading fails.
     const double travelled = (end.pose_world_body.translation() - start.pose_world_body.translation()).norm();
     EXPECT_LT(pos_err, kMaxPositionError_m) << profile_name(profile) << " t0=" << t0 << " travelled " << travelled;

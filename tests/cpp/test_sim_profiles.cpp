@@ -24,7 +24,9 @@ Extremes sample(const SequenceGenerator& gen, double duration_s, double from_s =
     const double v = s.velocity_world_m_s.norm();
     e.max_speed_m_s = std::max(e.max_speed_m_s, v);
     e.min_speed_m_s = std::min(e.min_speed_m_s, v);
-    if (v > kEps) e.max_lateral_m_s2 = std::max(e.max_lateral_m_s2, s.acceleration_world_m_s2.cross(s.velocity_world_m_s).norm() / v);
+    if (v > kEps)
+      e.max_lateral_m_s2 =
+          std::max(e.max_lateral_m_s2, s.acceleration_world_m_s2.cross(s.velocity_world_m_s).norm() / v);
     if (v < kEps) e.standstill_s += 1.0 / kSampleRate_hz;
     e.max_rate_rad_s = std::max(e.max_rate_rad_s, s.angular_velocity_body_rad_s.norm());
     e.z_min_m = std::min(e.z_min_m, s.pose_world_body.translation().z());
@@ -141,7 +143,8 @@ TEST(SimProfiles, VelocityIsTheDerivativeOfPosition) {
       const std::int64_t stamp = gen.config().start_stamp_ns + std::llround(t * 1e9);
       const BodyState s = gen.state(stamp), a = gen.state(stamp - kStep_ns), b = gen.state(stamp + kStep_ns);
       const Eigen::Vector3d v_fd = (b.pose_world_body.translation() - a.pose_world_body.translation()) / 2e-3;
-      EXPECT_LT((v_fd - s.velocity_world_m_s).norm(), 1e-3 * (1.0 + s.velocity_world_m_s.norm())) << profile_name(p) << t;
+      EXPECT_LT((v_fd - s.velocity_world_m_s).norm(), 1e-3 * (1.0 + s.velocity_world_m_s.norm()))
+          << profile_name(p) << t;
       const Eigen::Vector3d acc_fd = (b.velocity_world_m_s - a.velocity_world_m_s) / 2e-3;
       EXPECT_LT((acc_fd - s.acceleration_world_m_s2).norm(), 1e-2) << profile_name(p) << t;
       const Eigen::Vector3d w_fd =
@@ -162,7 +165,8 @@ TEST(SimConfigApi, ParseProfile) {
     const std::string msg = e.what();
     for (const char* name : {"moon", "racetrack", "urban", "handheld"}) EXPECT_NE(msg.find(name), std::string::npos);
   }
-  for (const Profile p : {Profile::Racetrack, Profile::Urban, Profile::Handheld}) EXPECT_EQ(parse_profile(profile_name(p)), p);
+  for (const Profile p : {Profile::Racetrack, Profile::Urban, Profile::Handheld})
+    EXPECT_EQ(parse_profile(profile_name(p)), p);
 }
 
 TEST(SimConfigApi, DefaultsDifferPerProfile) {

@@ -109,7 +109,9 @@ TEST_P(SimScanProfile, SameSeedBitIdenticalInAnyOrderOtherSeedDiffers) {
 
 INSTANTIATE_TEST_SUITE_P(Profiles, SimScanProfile,
                          ::testing::Values(Profile::Racetrack, Profile::Urban, Profile::Handheld),
-                         [](const ::testing::TestParamInfo<Profile>& param_info) { return profile_name(param_info.param); });
+                         [](const ::testing::TestParamInfo<Profile>& param_info) {
+                           return profile_name(param_info.param);
+                         });
 
 TEST(SimScan, SizesNearTargets) {
   // Racetrack ~200k points (3 x 128 x 570 rays), urban ~120k (64 x 1875 rays).
@@ -145,5 +147,6 @@ TEST(SimScan, RangeNoiseHasConfiguredSpread) {
     sum_sq += e * e;
     ++n;
   }
-  EXPECT_NEAR(std::sqrt(sum_sq / static_cast<double>(n)), cfg.noise.range_noise_std_m, 0.15 * cfg.noise.range_noise_std_m);
+  EXPECT_NEAR(std::sqrt(sum_sq / static_cast<double>(n)), cfg.noise.range_noise_std_m,
+              0.15 * cfg.noise.range_noise_std_m);
 }

@@ -16,8 +16,8 @@ inline std::filesystem::path shared_data() {
   return std::filesystem::is_directory(p) ? p : std::filesystem::path{};
 }
 
-#define FARLIO_REQUIRE_SHARED_DATA()                                              \
-  do {                                                                            \
+#define FARLIO_REQUIRE_SHARED_DATA()                                                       \
+  do {                                                                                     \
     if (::farlio::test::shared_data().empty()) GTEST_SKIP() << "../shared/data is absent"; \
   } while (0)
 

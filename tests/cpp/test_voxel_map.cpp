@@ -239,7 +239,7 @@ TEST(VoxelMap, CovarianceOfAPlaneIsFlat) {
     ++valid;
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3f> es(c.matrix());
     const Eigen::Vector3f normal = es.eigenvectors().col(0);
-    EXPECT_GT(std::abs(normal.z()), 0.99f);                // smallest axis is the plane normal
+    EXPECT_GT(std::abs(normal.z()), 0.99f);  // smallest axis is the plane normal
     EXPECT_LT(es.eigenvalues()(0) / es.eigenvalues()(2), 0.05f);
     EXPECT_NEAR(c.matrix().inverse().norm(), 1.0f, 1e-3f);  // Frobenius normalisation: ||Sigma^-1||_F = 1
     EXPECT_EQ(classify_shape(c.matrix(), 10.0f), PointShape::Surface);
@@ -267,8 +267,8 @@ TEST(Covariance, ClosedFormEigenvaluesEqualEigensSolver) {
 TEST(Covariance, ShapeOfLinesAndPlanes) {
   const float eps = 1e-3f;
   Eigen::Matrix3f line = Eigen::Matrix3f::Zero(), plane = Eigen::Matrix3f::Zero();
-  line(1, 1) = 1.0f;                     // 1 m spread along y, nothing across
-  plane(0, 0) = plane(1, 1) = 0.5f;      // a plane z = const
+  line(1, 1) = 1.0f;                 // 1 m spread along y, nothing across
+  plane(0, 0) = plane(1, 1) = 0.5f;  // a plane z = const
   EXPECT_EQ(classify_shape(regularize_frobenius(line, eps), 10.0f), PointShape::Line);
   EXPECT_EQ(classify_shape(regularize_frobenius(plane, eps), 10.0f), PointShape::Surface);
   EXPECT_EQ(classify_shape(regularize_frobenius(line, eps), 0.0f), PointShape::Surface);  // classification off

@@ -77,9 +77,9 @@ TEST(InsertionPlan, AGrownPoolGrowsTheTable) {
 }
 
 TEST(PoolCapacity, DoublesUpToTheLimit) {
-  EXPECT_EQ(grown_pool_capacity(10, 16, 100, kParameter), 16u);   // fits
-  EXPECT_EQ(grown_pool_capacity(17, 16, 100, kParameter), 32u);   // doubles
-  EXPECT_EQ(grown_pool_capacity(40, 16, 100, kParameter), 40u);   // more than double is needed
+  EXPECT_EQ(grown_pool_capacity(10, 16, 100, kParameter), 16u);  // fits
+  EXPECT_EQ(grown_pool_capacity(17, 16, 100, kParameter), 32u);  // doubles
+  EXPECT_EQ(grown_pool_capacity(40, 16, 100, kParameter), 40u);  // more than double is needed
   EXPECT_EQ(grown_pool_capacity(60, 64, 100, kParameter), 64u);
   EXPECT_EQ(grown_pool_capacity(65, 64, 100, kParameter), 100u);  // capped at the limit
   EXPECT_THROW(grown_pool_capacity(101, 64, 100, kParameter), CapacityError);
@@ -140,7 +140,7 @@ TEST(NewVoxelSlot, EqualsPoppingTheFreeListThenTheHighWaterMark) {
 }
 
 TEST(CovariancePoints, NewPointsOrTheWholeChangedVoxel) {
-  EXPECT_EQ(covariance_points(5, 5, true).size(), 0);   // unchanged voxel: nothing, even refreshing
+  EXPECT_EQ(covariance_points(5, 5, true).size(), 0);  // unchanged voxel: nothing, even refreshing
   EXPECT_EQ(covariance_points(5, 5, false).size(), 0);
   const PointRange fresh = covariance_points(8, 5, false);
   EXPECT_EQ(fresh.begin, 5);

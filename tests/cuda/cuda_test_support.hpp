@@ -12,8 +12,8 @@
 #include "farlio/cuda/device_voxel_map.hpp"
 #include "farlio/cuda/map_scratch.hpp"
 
-#define FARLIO_REQUIRE_GPU()                                                   \
-  do {                                                                         \
+#define FARLIO_REQUIRE_GPU()                                                  \
+  do {                                                                        \
     if (::farlio::cuda_device_count() == 0) GTEST_SKIP() << "no CUDA device"; \
   } while (0)
 

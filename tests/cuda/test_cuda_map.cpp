@@ -37,7 +37,8 @@ void expect_same_maps(const map::MapSnapshot& cpu, const map::MapSnapshot& gpu) 
     for (std::size_t j = 0; j < static_cast<std::size_t>(cpu.voxel_counts[v]); ++j, ++compared) {
       const std::size_t i = v * n + j;
       ASSERT_EQ(cpu.points[i].head<3>(), gpu.points[i].head<3>()) << "voxel " << v << " point " << j;
-      ASSERT_EQ(map::has_covariance(cpu.points[i]), map::has_covariance(gpu.points[i])) << "voxel " << v << " point " << j;
+      ASSERT_EQ(map::has_covariance(cpu.points[i]), map::has_covariance(gpu.points[i]))
+          << "voxel " << v << " point " << j;
       flips += map::is_line_like(cpu.points[i]) != map::is_line_like(gpu.points[i]) ? 1 : 0;
       if (!map::has_covariance(cpu.points[i])) continue;
       const Eigen::Matrix3f a = cpu.covs[i].matrix(), b = gpu.covs[i].matrix();

@@ -1,4 +1,5 @@
 """Shared fixtures: the real recordings in ../shared/data (tests skip without them)."""
+
 from __future__ import annotations
 
 import os

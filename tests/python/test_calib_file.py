@@ -1,4 +1,5 @@
 """`--calib` files and extrinsic matrices go through the C++ reader and its rigidity check."""
+
 from __future__ import annotations
 
 import numpy as np

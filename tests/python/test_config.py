@@ -1,10 +1,10 @@
 """The parameter set from Python: typed values, validation naming the field, the YAML round trip."""
+
 from __future__ import annotations
 
 import math
 
 import pytest
-
 from farlio import _core
 from farlio.config import config_to_yaml, load_config
 
@@ -30,14 +30,22 @@ def test_set_takes_numbers_bools_and_text():
     assert cfg.get("density.enabled") is False
     assert cfg.get("registration.max_iterations") == 7
     assert math.isinf(cfg.get("map.removal_radius_m"))
-    assert repr(cfg) == ("Config(map.voxel_size_m=2, map.removal_radius_m=inf, density.enabled=false, "
-                         "registration.max_iterations=7)")
+    assert repr(cfg) == (
+        "Config(map.voxel_size_m=2, map.removal_radius_m=inf, density.enabled=false, registration.max_iterations=7)"
+    )
     assert repr(_core.Config()) == "Config(defaults)"
 
 
-@pytest.mark.parametrize("name,value", [("fusion.step_s", 0), ("map.voxel_size_m", -1.0),
-                                        ("preprocess.min_range_m", math.nan), ("registration.max_iterations", 2.5),
-                                        ("num_threads", -1)])
+@pytest.mark.parametrize(
+    "name,value",
+    [
+        ("fusion.step_s", 0),
+        ("map.voxel_size_m", -1.0),
+        ("preprocess.min_range_m", math.nan),
+        ("registration.max_iterations", 2.5),
+        ("num_threads", -1),
+    ],
+)
 def test_a_bad_value_is_an_error_naming_the_field_and_leaves_the_config(name, value):
     cfg = _core.Config()
     before = cfg.get(name)
@@ -56,8 +64,15 @@ def test_rules_between_fields_are_checked_when_loading(tmp_path):
 
 
 def test_the_written_yaml_reads_back_to_the_same_config(tmp_path):
-    cfg = load_config(overrides=["map.voxel_size_m=2.5", "fusion.enabled=false", "registration.damping=1e-7",
-                                 "device=cpu", "registration.time_budget_factor=inf"])
+    cfg = load_config(
+        overrides=[
+            "map.voxel_size_m=2.5",
+            "fusion.enabled=false",
+            "registration.damping=1e-7",
+            "device=cpu",
+            "registration.time_budget_factor=inf",
+        ]
+    )
     f = tmp_path / "config.yaml"
     f.write_text(config_to_yaml(cfg))
     back = load_config(f)

@@ -1,6 +1,7 @@
 """KITTI raw and MulRan layouts written from a short generated sequence: the dataloaders read back
 exactly what was written (scans, stamps, OXTS IMU, calibration, ground truth) and give the same
 trajectory as the sequence folder read without per-point times (neither layout has them)."""
+
 from __future__ import annotations
 
 import json
@@ -25,7 +26,7 @@ POSE_TOLERANCE_M = 1e-3
 #: a fixed result latency makes the replay deterministic (the measured one varies with the load)
 FIXED_LATENCY_S = 0.01
 DETERMINISTIC = replay_options("fixed", FIXED_LATENCY_S)
-OXTS_ACCEL, OXTS_GYRO = 11, 17   # first column of ax ay az and of wx wy wz
+OXTS_ACCEL, OXTS_GYRO = 11, 17  # first column of ax ay az and of wx wy wz
 #: where the generated drive is put on the Earth (Karlsruhe), and its altitude
 ORIGIN_LAT_DEG, ORIGIN_LON_DEG, ORIGIN_ALT_M = 49.0, 8.4, 110.0
 #: OXTS positions go through degrees of latitude/longitude and back
@@ -45,8 +46,12 @@ class WithoutTimes:
 
     def scan(self, i):
         s = self.inner.scan(i)
-        return farlio.Scan(np.asarray(s.points), intensity=np.asarray(s.intensity), start_stamp_ns=s.start_stamp_ns,
-                           end_stamp_ns=s.end_stamp_ns)
+        return farlio.Scan(
+            np.asarray(s.points),
+            intensity=np.asarray(s.intensity),
+            start_stamp_ns=s.start_stamp_ns,
+            end_stamp_ns=s.end_stamp_ns,
+        )
 
     def __getattr__(self, name):
         if name == "imu" and not self.use_imu:
@@ -94,15 +99,19 @@ def write_kitti_raw(folder, date_dir: Path) -> Path:
         row[1] = np.degrees(x / (scale * EARTH_RADIUS_M))
         row[2] = ORIGIN_ALT_M + w[2, 3] - first[2, 3]
         row[3:6] = [np.arctan2(w[2, 1], w[2, 2]), -np.arcsin(w[2, 0]), np.arctan2(w[1, 0], w[0, 0])]
-        row[OXTS_ACCEL:OXTS_ACCEL + 3] = sample.accel_m_s2
-        row[OXTS_GYRO:OXTS_GYRO + 3] = sample.gyro_rad_s
+        row[OXTS_ACCEL : OXTS_ACCEL + 3] = sample.accel_m_s2
+        row[OXTS_GYRO : OXTS_GYRO + 3] = sample.gyro_rad_s
         (drive / "oxts" / "data" / f"{k:010d}.txt").write_text(" ".join(repr(float(v)) for v in row) + "\n")
         stamps.append(kitti_stamp(sample.stamp_ns))
     (drive / "oxts" / "timestamps.txt").write_text("\n".join(stamps) + "\n")
     m = folder.T_imu_lidar().inverse().matrix()  # calib_imu_to_velo maps IMU points into the Velodyne frame
     (date_dir / "calib_imu_to_velo.txt").write_text(
-        "calib_time: 25-May-2012 12:00:00\nR: " + " ".join(repr(float(v)) for v in m[:3, :3].ravel()) +
-        "\nT: " + " ".join(repr(float(v)) for v in m[:3, 3]) + "\n")
+        "calib_time: 25-May-2012 12:00:00\nR: "
+        + " ".join(repr(float(v)) for v in m[:3, :3].ravel())
+        + "\nT: "
+        + " ".join(repr(float(v)) for v in m[:3, 3])
+        + "\n"
+    )
     return drive
 
 
@@ -188,11 +197,11 @@ def test_mulran_missing_scan_files_are_reported(sequence, tmp_path):
     assert any("1 Ouster stamps without a file" in w and victim.stem in w for w in ds.warnings())
 
 
-
 def test_kitti_odometry_times_convert_exactly(tmp_path):
     """times.txt seconds become exact integer ns, also for Unix times that a float64 cannot hold to
     the nanosecond (the dataloader shifts them by one default period)."""
     from farlio.datasets.folders import DEFAULT_PERIOD_NS
+
     times_s = ["1700000000.123456789", "1700000000.223456791"]
     (tmp_path / "velodyne").mkdir()
     for k in range(len(times_s)):

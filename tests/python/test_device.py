@@ -1,10 +1,10 @@
 """--device on the command line: auto falls back to the CPU with a one-line message when no GPU
 is present; cuda without one is a clear error (exit 2); a bad name is rejected by argparse."""
+
 from __future__ import annotations
 
-import pytest
-
 import farlio
+import pytest
 from farlio import _core
 from farlio.cli import main
 

@@ -1,5 +1,6 @@
 """farlio's trajectory metrics against evo (APE, RPE), kiss-icp (KITTI-style error) and numpy
 brute force, on synthetic trajectories written to TUM/KITTI files."""
+
 from __future__ import annotations
 
 import json
@@ -72,8 +73,10 @@ def write_tum(path: Path, stamps_s: np.ndarray, poses: np.ndarray) -> Path:
     with open(path, "w") as f:
         for t, p in zip(stamps_s, poses):
             q = quat_xyzw(p[:3, :3])
-            f.write(f"{t:.9f} {p[0, 3]:.12f} {p[1, 3]:.12f} {p[2, 3]:.12f} "
-                    f"{q[0]:.15f} {q[1]:.15f} {q[2]:.15f} {q[3]:.15f}\n")
+            f.write(
+                f"{t:.9f} {p[0, 3]:.12f} {p[1, 3]:.12f} {p[2, 3]:.12f} "
+                f"{q[0]:.15f} {q[1]:.15f} {q[2]:.15f} {q[3]:.15f}\n"
+            )
     return path
 
 
@@ -116,8 +119,10 @@ def test_aligned_ape_matches_evo(files):
     ref, est = evo_pair(files)
     est.align(ref, correct_scale=False)
     ours = evaluation.evaluate_files(files["est"], files["gt"], plot=False)
-    for relation, key in ((metrics.PoseRelation.translation_part, "translation_m"),
-                          (metrics.PoseRelation.rotation_angle_deg, "rotation_deg")):
+    for relation, key in (
+        (metrics.PoseRelation.translation_part, "translation_m"),
+        (metrics.PoseRelation.rotation_angle_deg, "rotation_deg"),
+    ):
         ape = metrics.APE(relation)
         ape.process_data((ref, est))
         stats = ape.get_all_statistics()
@@ -126,20 +131,23 @@ def test_aligned_ape_matches_evo(files):
     assert ours["associated_poses"] == ref.num_poses
 
 
-@pytest.mark.parametrize("delta,unit,all_pairs", [(1, "frames", False), (10, "frames", True),
-                                                  (5.0, "m", False), (20.0, "m", True)])
+@pytest.mark.parametrize(
+    "delta,unit,all_pairs", [(1, "frames", False), (10, "frames", True), (5.0, "m", False), (20.0, "m", True)]
+)
 def test_rpe_matches_evo(files, delta, unit, all_pairs):
     pytest.importorskip("evo")
     from evo.core import metrics
 
     ref, est = evo_pair(files)
     evo_unit = metrics.Unit.meters if unit == "m" else metrics.Unit.frames
-    ours = evaluation.evaluate_files(files["est"], files["gt"], plot=False, rpe_delta=delta, rpe_unit=unit,
-                                     rpe_all_pairs=all_pairs)
-    for relation, key in ((metrics.PoseRelation.translation_part, "translation_m"),
-                          (metrics.PoseRelation.rotation_angle_deg, "rotation_deg")):
-        rpe = metrics.RPE(relation, delta=delta, delta_unit=evo_unit, all_pairs=all_pairs,
-                          pairs_from_reference=True)
+    ours = evaluation.evaluate_files(
+        files["est"], files["gt"], plot=False, rpe_delta=delta, rpe_unit=unit, rpe_all_pairs=all_pairs
+    )
+    for relation, key in (
+        (metrics.PoseRelation.translation_part, "translation_m"),
+        (metrics.PoseRelation.rotation_angle_deg, "rotation_deg"),
+    ):
+        rpe = metrics.RPE(relation, delta=delta, delta_unit=evo_unit, all_pairs=all_pairs, pairs_from_reference=True)
         rpe.process_data((ref, est))
         stats = rpe.get_all_statistics()
         assert ours["rpe"]["pair_count"] == len(rpe.error)
@@ -167,7 +175,7 @@ def test_kitti_rpe_matches_brute_force(files):
     gt, est = files["gt_poses"], files["est_poses"]
     ours = evaluation.evaluate_files(files["est"], files["gt"], plot=False, kitti_step=3)
     path_m = ours["groundtruth_path_length_m"]
-    lengths = KITTI_LENGTHS_M if path_m >= 1000.0 else [l / 10 for l in KITTI_LENGTHS_M]
+    lengths = KITTI_LENGTHS_M if path_m >= 1000.0 else [length / 10 for length in KITTI_LENGTHS_M]
     assert ours["kitti_rpe"]["segment_lengths_m"] == lengths
     t_pct, r_deg = brute_force_kitti(gt, est, lengths, step=3)
     assert ours["kitti_rpe"]["translation_pct"] == pytest.approx(t_pct, rel=REL_TOL)
@@ -177,8 +185,13 @@ def test_kitti_rpe_matches_brute_force(files):
 def test_kitti_rpe_matches_kiss_icp(files):
     kiss_metrics = pytest.importorskip("kiss_icp.metrics")
     gt, est = files["gt_poses"], files["est_poses"]
-    ours = evaluation.evaluate_files(files["est_kitti"], files["gt_kitti"], plot=False,
-                                     kitti_step=KITTI_DEVKIT_STEP, segment_lengths_m=KITTI_LENGTHS_M)
+    ours = evaluation.evaluate_files(
+        files["est_kitti"],
+        files["gt_kitti"],
+        plot=False,
+        kitti_step=KITTI_DEVKIT_STEP,
+        segment_lengths_m=KITTI_LENGTHS_M,
+    )
     assert ours["kitti_rpe"]["segment_count"] > 0
     kiss_t, kiss_r = kiss_metrics.sequence_error(gt, est)
     # kiss-icp reports the translational error in percent and the rotational one in deg/m. The

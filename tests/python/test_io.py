@@ -1,4 +1,5 @@
 """farlio._core.io from Python: round trips through the bound readers and writers."""
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -13,7 +14,7 @@ POINTS = 500
 SEED = 3
 
 
-def random_scan(end_stamp_ns: int = 0) -> "core.Scan":
+def random_scan(end_stamp_ns: int = 0) -> core.Scan:
     rng = np.random.default_rng(SEED)
     pts = rng.uniform(-50.0, 50.0, (POINTS, 3)).astype(np.float32)
     t = rng.uniform(0.0, 0.1, POINTS).astype(np.float32)
@@ -89,6 +90,7 @@ def test_sequence_round_trip(tmp_path: Path) -> None:
 
 def test_ns_per_s_is_one_integer_for_every_module() -> None:
     from farlio.datasets import kitti_raw, pointcloud2
+
     assert core.NS_PER_S == 1_000_000_000 and isinstance(core.NS_PER_S, int)
     assert pointcloud2.NS_PER_S is core.NS_PER_S and kitti_raw.NS_PER_S is core.NS_PER_S
 

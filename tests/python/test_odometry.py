@@ -1,19 +1,19 @@
 """LiDAR-only odometry end to end (simulate -> run -> eval) on generated sequences with exact
 ground truth, against bounds set from measurement (docs/odometry.md gives the measured values),
 and per-frame agreement with KISS-ICP on the real KITTI scans."""
+
 from __future__ import annotations
 
 import json
 from pathlib import Path
 
+import farlio
 import numpy as np
 import pytest
-
-import farlio
 from farlio import _core
 from farlio.cli import main as cli
-from farlio.datasets import open_dataset
 from farlio.config import load_config
+from farlio.datasets import open_dataset
 from farlio.runner import replay_options, run_dataset
 from farlio.simulation import generate
 
@@ -60,8 +60,14 @@ def runs(tmp_path_factory, sequences):
         if key not in done:
             out = root / f"{profile}_{duration:g}_{mode}"
             config = load_config(None, [] if mode == "lio" else ["fusion.enabled=false"])
-            summary = run_dataset(open_dataset(sequences(profile, duration)), out, config, progress=False,
-                                  plot=False, options=replay_options("fixed", 0.02))
+            summary = run_dataset(
+                open_dataset(sequences(profile, duration)),
+                out,
+                config,
+                progress=False,
+                plot=False,
+                options=replay_options("fixed", 0.02),
+            )
             done[key] = (out, summary)
         return done[key]
 
@@ -69,8 +75,7 @@ def runs(tmp_path_factory, sequences):
 
 
 @pytest.mark.parametrize("profile,duration,mode,ape_bound,rpe_bound,odom_bound", CASES)
-def test_odometry_on_generated_sequences(runs, sequences, profile, duration, mode, ape_bound, rpe_bound,
-                                         odom_bound):
+def test_odometry_on_generated_sequences(runs, sequences, profile, duration, mode, ape_bound, rpe_bound, odom_bound):
     seq = sequences(profile, duration)
     out, summary = runs(profile, duration, mode)
     acc = summary["accuracy"]
@@ -85,8 +90,15 @@ def test_odometry_on_generated_sequences(runs, sequences, profile, duration, mod
     if odom_bound is not None:
         assert summary["accuracy_odometry"]["ape"]["translation_m"]["rmse"] < odom_bound
         assert summary["accuracy_odometry"]["coverage"] > 0.95
-    names = ["scans_lidar.tum", "scans_body.tum", "scans_lidar_kitti.txt", "timing.csv", "summary.json",
-             "config.yaml", "eval_scans/eval.json"] + (["odometry_body.tum"] if mode == "lio" else [])
+    names = [
+        "scans_lidar.tum",
+        "scans_body.tum",
+        "scans_lidar_kitti.txt",
+        "timing.csv",
+        "summary.json",
+        "config.yaml",
+        "eval_scans/eval.json",
+    ] + (["odometry_body.tum"] if mode == "lio" else [])
     for name in names:
         assert (out / name).exists(), name
     assert len(_core.io.read_tum(out / "scans_body.tum")) == summary["processed"]
@@ -96,8 +108,15 @@ def test_replay_is_deterministic_with_a_fixed_latency(tmp_path, sequences):
     seq = sequences("urban", 10.0)
     outs = []
     for k in range(2):
-        run_dataset(open_dataset(seq), tmp_path / f"r{k}", None, progress=False, plot=False,
-                    options=replay_options("fixed", 0.03), max_frames=40)
+        run_dataset(
+            open_dataset(seq),
+            tmp_path / f"r{k}",
+            None,
+            progress=False,
+            plot=False,
+            options=replay_options("fixed", 0.03),
+            max_frames=40,
+        )
         outs.append((tmp_path / f"r{k}" / "odometry_body.tum").read_text())
     assert outs[0] == outs[1] and len(outs[0].splitlines()) > 300
 
@@ -182,8 +201,10 @@ def test_ablation_and_latency_sweep_commands(tmp_path, sequences):
     full = rows[-1].split(",")
     assert full[0] == "EKF+DC+MU+SA+ASMD" and float(full[1]) < 0.05
     assert (tmp_path / "abl" / "ablation.md").exists()
-    assert cli(["latency-sweep", str(seq), "--out", str(tmp_path / "sw"), "--delays-ms", "0", "50",
-                "--max-frames", "40"]) == 0
+    assert (
+        cli(["latency-sweep", str(seq), "--out", str(tmp_path / "sw"), "--delays-ms", "0", "50", "--max-frames", "40"])
+        == 0
+    )
     sweep = (tmp_path / "sw" / "latency_sweep.csv").read_text().splitlines()
     assert len(sweep) == 3 and (tmp_path / "sw" / "latency_sweep.png").exists()
 

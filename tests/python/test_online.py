@@ -1,18 +1,18 @@
 """The online (threaded) odometry from Python: IMU pushed from a second Python thread, scans from
 the main one, in lockstep, must give the deterministic replay's trajectory (zero latency)."""
+
 from __future__ import annotations
 
 import threading
 
-import numpy as np
-
 import farlio
+import numpy as np
 from farlio import _core
 
 
 def test_online_odometry_from_two_python_threads_equals_the_replay(tmp_path):
-    from farlio.simulation import generate
     from farlio.datasets import open_dataset
+    from farlio.simulation import generate
 
     seq = tmp_path / "urban"
     generate("urban", seq, duration_s=2.0)
@@ -61,4 +61,7 @@ def test_online_odometry_from_two_python_threads_equals_the_replay(tmp_path):
     samples = online.take_odometry()
     assert len(samples) == len(expected_odometry) > 150
     assert [s.stamp_ns for s in samples] == [t for t, _ in expected_odometry]
-    assert max(np.abs(s.body_pose.translation - p.translation).max() for s, (_, p) in zip(samples, expected_odometry)) < 1e-6
+    assert (
+        max(np.abs(s.body_pose.translation - p.translation).max() for s, (_, p) in zip(samples, expected_odometry))
+        < 1e-6
+    )

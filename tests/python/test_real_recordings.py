@@ -2,6 +2,7 @@
 (+ json) and the Ouster ROS 1 packet bag with their IMU packets, the Ouster OSF file, and the 16
 KITTI scans. Skipped
 without ../shared/data (or without ouster-sdk for the Ouster files)."""
+
 from __future__ import annotations
 
 import json

@@ -1,5 +1,6 @@
 """Bound objects print their values: repr() names the type and shows the numbers, never
 '<... object at 0x...>'."""
+
 from __future__ import annotations
 
 import math

@@ -2,6 +2,7 @@
 sqlite3 and MCAP) and per-point time convention (Ouster, Velodyne, Hesai, Livox, Robosense) read
 back by the dataloader gives the same trajectory as the sequence folder; two LiDAR topics merge
 into the original scans; bad bags, topics and fields fail with errors that name them."""
+
 from __future__ import annotations
 
 import re
@@ -64,12 +65,15 @@ def assert_same_trajectory(a: np.ndarray, b: np.ndarray, tolerance_m: float) -> 
     assert np.all(dots > np.cos(tolerance_m / 2.0))
 
 
-@pytest.mark.parametrize("storage,convention", [("ros1", "ouster"), ("sqlite3", "velodyne"), ("mcap", "hesai"),
-                                                ("mcap", "livox"), ("ros1", "robosense")])
+@pytest.mark.parametrize(
+    "storage,convention",
+    [("ros1", "ouster"), ("sqlite3", "velodyne"), ("mcap", "hesai"), ("mcap", "livox"), ("ros1", "robosense")],
+)
 def test_bag_gives_the_folder_trajectory(sequence, reference, tmp_path, storage, convention):
     folder = open_dataset(sequence)
-    bag = write_dataset(folder, tmp_path / ("rec.bag" if storage == "ros1" else "rec"), storage, convention,
-                        padding=POINT_PADDING)
+    bag = write_dataset(
+        folder, tmp_path / ("rec.bag" if storage == "ros1" else "rec"), storage, convention, padding=POINT_PADDING
+    )
     assert detect_format(bag) == "rosbag"
     ds = open_dataset(bag)
     assert ds.warnings() == []
@@ -119,8 +123,9 @@ def test_two_lidars_merge_into_the_original_scans(sequence, reference, tmp_path)
     assert_same_trajectory(reference, run_poses(ds, tmp_path / "out"), MERGED_POSE_TOLERANCE_M)
 
 
-def small_bag(path: Path, storage: str = "ros1", fields=("x", "y", "z"), times=None, topic="/points",
-              convention: str = "ouster") -> Path:
+def small_bag(
+    path: Path, storage: str = "ros1", fields=("x", "y", "z"), times=None, topic="/points", convention: str = "ouster"
+) -> Path:
     """A bag of 3 small clouds (+ a few IMU samples) whose points and fields are given."""
     rng = np.random.default_rng(0)
     with BagWriter(path, storage) as w:
@@ -131,28 +136,43 @@ def small_bag(path: Path, storage: str = "ros1", fields=("x", "y", "z"), times=N
                 w.cloud(topic, "lidar", start, start + 100_000_000, pts, times, None, convention)
             else:
                 _raw_cloud(w, topic, start, fields)
-        w.imu("/imu", "imu", [farlio.ImuSample(1_000_000_000 + k * 10_000_000, np.zeros(3), np.array([0, 0, 9.81]))
-                              for k in range(3)])
+        w.imu(
+            "/imu",
+            "imu",
+            [farlio.ImuSample(1_000_000_000 + k * 10_000_000, np.zeros(3), np.array([0, 0, 9.81])) for k in range(3)],
+        )
     return path
 
 
 def _raw_cloud(w: BagWriter, topic: str, stamp: int, fields) -> None:
     ft = w._type("sensor_msgs/msg/PointField")
     msg = w._type("sensor_msgs/msg/PointCloud2")(
-        header=w._header(stamp, "lidar"), height=1, width=4,
+        header=w._header(stamp, "lidar"),
+        height=1,
+        width=4,
         fields=[ft(name=n, offset=4 * k, datatype=7, count=1) for k, n in enumerate(fields)],
-        is_bigendian=False, point_step=4 * len(fields), row_step=16 * len(fields),
-        data=np.zeros(16 * len(fields), np.uint8), is_dense=True)
+        is_bigendian=False,
+        point_step=4 * len(fields),
+        row_step=16 * len(fields),
+        data=np.zeros(16 * len(fields), np.uint8),
+        is_dense=True,
+    )
     w._write(topic, "sensor_msgs/msg/PointCloud2", stamp, msg)
 
 
 def test_missing_and_wrong_topics_are_named(tmp_path):
     bag = small_bag(tmp_path / "a.bag")
-    with pytest.raises(ValueError, match=r"a\.bag: no topic '/velodyne_points' \(--lidar-topic\); "
-                                         r"sensor_msgs/msg/PointCloud2 topics: /points"):
+    with pytest.raises(
+        ValueError,
+        match=r"a\.bag: no topic '/velodyne_points' \(--lidar-topic\); "
+        r"sensor_msgs/msg/PointCloud2 topics: /points",
+    ):
         open_dataset(bag, options=LoadOptions(lidar_topics=["/velodyne_points"]))
-    with pytest.raises(ValueError, match=r"topic '/imu' \(--lidar-topic\) is sensor_msgs/msg/Imu; expected "
-                                         r"sensor_msgs/msg/PointCloud2"):
+    with pytest.raises(
+        ValueError,
+        match=r"topic '/imu' \(--lidar-topic\) is sensor_msgs/msg/Imu; expected "
+        r"sensor_msgs/msg/PointCloud2",
+    ):
         open_dataset(bag, options=LoadOptions(lidar_topics=["/imu"]))
     with pytest.raises(ValueError, match=r"no topic '/imu0' \(--imu-topic\); sensor_msgs/msg/Imu topics: /imu"):
         open_dataset(bag, options=LoadOptions(imu_topic="/imu0"))
@@ -160,8 +180,11 @@ def test_missing_and_wrong_topics_are_named(tmp_path):
 
 def test_cloud_without_xyz_names_its_fields(tmp_path):
     bag = small_bag(tmp_path / "b", "sqlite3", fields=("a", "b", "c"))
-    with pytest.raises(ValueError, match=r"topic /points .*no field 'x', 'y', 'z' \(fields: a, b, c\); "
-                                         r"expected x, y, z"):
+    with pytest.raises(
+        ValueError,
+        match=r"topic /points .*no field 'x', 'y', 'z' \(fields: a, b, c\); "
+        r"expected x, y, z",
+    ):
         open_dataset(bag)
 
 
@@ -179,8 +202,16 @@ def test_no_time_field_warns_and_skips_undistortion(tmp_path):
     path = tmp_path / "d.bag"
     with BagWriter(path) as w:
         for k in range(2):
-            w.cloud("/points", "lidar", k * 100_000_000 + 1, (k + 1) * 100_000_000 + 1,
-                    np.asarray(folder_scan.points), None, None, "none")
+            w.cloud(
+                "/points",
+                "lidar",
+                k * 100_000_000 + 1,
+                (k + 1) * 100_000_000 + 1,
+                np.asarray(folder_scan.points),
+                None,
+                None,
+                "none",
+            )
     ds = open_dataset(path)
     assert any("no per-point time field" in m and "/points" in m for m in ds.warnings())
     assert len(ds.scan(1).time_s) == 0 and ds.scan(1).end_stamp_ns == 200_000_001
@@ -188,8 +219,9 @@ def test_no_time_field_warns_and_skips_undistortion(tmp_path):
 
 @pytest.mark.parametrize("storage", ["ros1", "mcap", "sqlite3"])
 def test_truncated_bag_is_a_clear_error(sequence, tmp_path, storage, capsys):
-    bag = write_dataset(open_dataset(sequence), tmp_path / ("t.bag" if storage == "ros1" else "t"), storage,
-                        max_scans=4)
+    bag = write_dataset(
+        open_dataset(sequence), tmp_path / ("t.bag" if storage == "ros1" else "t"), storage, max_scans=4
+    )
     file = bag if storage == "ros1" else next(p for p in bag.iterdir() if p.suffix in (".mcap", ".db3"))
     data = file.read_bytes()
     file.write_bytes(data[: len(data) // 2])

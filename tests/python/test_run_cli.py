@@ -1,5 +1,6 @@
 """`farlio run` options for recordings: documented in --help, and --view without rerun-sdk is a
 clear error, not a traceback."""
+
 from __future__ import annotations
 
 import sys
@@ -10,8 +11,21 @@ pytest.importorskip("farlio._core")
 
 from farlio.cli import build_parser, main  # noqa: E402
 
-RECORDING_OPTIONS = ["--lidar-topic", "--imu-topic", "--calib", "--meta", "--time-field", "--time-unit",
-                     "--header-stamp", "--no-imu", "--view", "--no-plot", "--format", "--gt", "--out"]
+RECORDING_OPTIONS = [
+    "--lidar-topic",
+    "--imu-topic",
+    "--calib",
+    "--meta",
+    "--time-field",
+    "--time-unit",
+    "--header-stamp",
+    "--no-imu",
+    "--view",
+    "--no-plot",
+    "--format",
+    "--gt",
+    "--out",
+]
 
 
 def test_run_help_documents_every_recording_option(capsys):

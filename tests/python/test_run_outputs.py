@@ -1,5 +1,6 @@
 """What `run_dataset` writes: timing.csv rows built from named fields (every row holds exactly the
 header's columns, in its order) and the keys of summary.json."""
+
 from __future__ import annotations
 
 import csv
@@ -16,9 +17,26 @@ from farlio.simulation import generate  # noqa: E402
 from farlio.timing_csv import TIMING_COLUMNS, TimingCsv, timing_row  # noqa: E402
 
 SIM_DURATION_S = 1.0
-SUMMARY_KEYS = ["dataset", "mode", "frames", "processed", "skipped", "dropped", "registered", "converged_fraction",
-                "latency_ms", "wall_s", "rate_hz", "device", "map_memory_bytes", "threads", "fusion", "accuracy",
-                "accuracy_odometry", "voxel_size_m"]
+SUMMARY_KEYS = [
+    "dataset",
+    "mode",
+    "frames",
+    "processed",
+    "skipped",
+    "dropped",
+    "registered",
+    "converged_fraction",
+    "latency_ms",
+    "wall_s",
+    "rate_hz",
+    "device",
+    "map_memory_bytes",
+    "threads",
+    "fusion",
+    "accuracy",
+    "accuracy_odometry",
+    "voxel_size_m",
+]
 LATENCY_KEYS = ["median", "p99", "max", "mean"]
 
 

@@ -1,5 +1,6 @@
 """The sequence generator through the Python bindings: configuration, scans as numpy views,
 IMU arrays, exact states, determinism and GIL release."""
+
 from __future__ import annotations
 
 import threading

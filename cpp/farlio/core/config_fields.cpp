@@ -13,7 +13,7 @@ namespace {
 // parameters of the function the list expands in.
 #define FARLIO_FIELD_ENTRY(type, name, default_value, valid, doc) \
   out.push_back(ConfigField{prefix + #name, &section.name, doc, valid});
-#define FARLIO_SECTION_FIELDS(Section, LIST)                                                      \
+#define FARLIO_SECTION_FIELDS(Section, LIST)                                                       \
   void append_fields(std::vector<ConfigField>& out, Section& section, const std::string& prefix) { \
     LIST(FARLIO_FIELD_ENTRY)                                                                       \
   }

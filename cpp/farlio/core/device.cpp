@@ -35,7 +35,8 @@ Device resolve_device(Device requested, std::string* message) {
   const int n = built ? cuda_device_count() : 0;
   if (n > 0) return Device::Cuda;
   const std::string why = built ? "no CUDA device was found" : "this build has no CUDA backend";
-  if (requested == Device::Cuda) throw std::runtime_error("device cuda was requested but " + why + " (use --device auto or cpu)");
+  if (requested == Device::Cuda)
+    throw std::runtime_error("device cuda was requested but " + why + " (use --device auto or cpu)");
   if (message) *message = "device auto: " + why + "; running on the CPU";
   return Device::Cpu;
 }

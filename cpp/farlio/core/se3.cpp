@@ -42,16 +42,13 @@ Mat3d so3_left_jacobian_inverse(const Eigen::Vector3d& phi) {
   return Mat3d::Identity() - 0.5 * K + (1.0 / (th * th)) * (1.0 - half * cot) * K * K;
 }
 
-SE3 SE3::from_matrix(const Mat4d& m) {
-  return {Mat3d(m.block<3, 3>(0, 0)), Eigen::Vector3d(m.block<3, 1>(0, 3))};
-}
+SE3 SE3::from_matrix(const Mat4d& m) { return {Mat3d(m.block<3, 3>(0, 0)), Eigen::Vector3d(m.block<3, 1>(0, 3))}; }
 
 SE3 SE3::exp(const Vec6d& xi) {
   const Eigen::Vector3d rho = xi.head<3>(), phi = xi.tail<3>();
   const double th = phi.norm();
-  Eigen::Quaterniond q = th < kSmallAngleRad
-                             ? Eigen::Quaterniond(1.0, 0.5 * phi.x(), 0.5 * phi.y(), 0.5 * phi.z())
-                             : Eigen::Quaterniond(Eigen::AngleAxisd(th, phi / th));
+  Eigen::Quaterniond q = th < kSmallAngleRad ? Eigen::Quaterniond(1.0, 0.5 * phi.x(), 0.5 * phi.y(), 0.5 * phi.z())
+                                             : Eigen::Quaterniond(Eigen::AngleAxisd(th, phi / th));
   return {q, so3_left_jacobian(phi) * rho};
 }
 
@@ -80,8 +77,6 @@ double SE3::angle_rad() const {
   return 2.0 * std::atan2(q_.vec().norm(), w);
 }
 
-SE3 interpolate(const SE3& a, const SE3& b, double s) {
-  return a * SE3::exp(s * (a.inverse() * b).log());
-}
+SE3 interpolate(const SE3& a, const SE3& b, double s) { return a * SE3::exp(s * (a.inverse() * b).log()); }
 
 }  // namespace farlio

@@ -10,16 +10,16 @@ void Scan::validate(const std::string& what) const {
   const auto n = points.size();
   auto check = [&](std::size_t m, const char* field) {
     if (m != 0 && m != n) {
-      throw InputError(what + ": field '" + field + "' has " + std::to_string(m) +
-                       " values for " + std::to_string(n) + " points");
+      throw InputError(what + ": field '" + field + "' has " + std::to_string(m) + " values for " + std::to_string(n) +
+                       " points");
     }
   };
   check(time_s.size(), "time_s");
   check(intensity.size(), "intensity");
   check(sensor_id.size(), "sensor_id");
   if (end_stamp_ns < start_stamp_ns) {
-    throw InputError(what + ": scan end stamp " + std::to_string(end_stamp_ns) +
-                     " ns is before its start stamp " + std::to_string(start_stamp_ns) + " ns");
+    throw InputError(what + ": scan end stamp " + std::to_string(end_stamp_ns) + " ns is before its start stamp " +
+                     std::to_string(start_stamp_ns) + " ns");
   }
 }
 

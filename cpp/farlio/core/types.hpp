@@ -30,9 +30,7 @@ struct Scan {
   [[nodiscard]] std::size_t size() const { return points.size(); }
   [[nodiscard]] bool empty() const { return points.empty(); }
   [[nodiscard]] bool has_time() const { return !time_s.empty(); }
-  [[nodiscard]] double duration_s() const {
-    return ns_to_seconds(end_stamp_ns - start_stamp_ns);
-  }
+  [[nodiscard]] double duration_s() const { return ns_to_seconds(end_stamp_ns - start_stamp_ns); }
   /// Throws InputError naming `what` if array sizes disagree or the stamps are inverted.
   void validate(const std::string& what) const;
   /// Removes points with a non-finite coordinate or time; returns how many were removed.
@@ -42,8 +40,8 @@ struct Scan {
 /// One IMU reading in the IMU (body) frame.
 struct ImuSample {
   std::int64_t stamp_ns = 0;
-  Vec3d gyro_rad_s = Vec3d::Zero();    ///< angular rate
-  Vec3d accel_m_s2 = Vec3d::Zero();    ///< specific force (about +9.81 on z when level at rest)
+  Vec3d gyro_rad_s = Vec3d::Zero();  ///< angular rate
+  Vec3d accel_m_s2 = Vec3d::Zero();  ///< specific force (about +9.81 on z when level at rest)
 };
 
 }  // namespace farlio

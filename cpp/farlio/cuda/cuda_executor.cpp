@@ -2,8 +2,7 @@
 
 namespace farlio::cuda {
 
-CudaExecutor::CudaExecutor()
-    : partials_((kMaxReduceBlocks + 1) * kMaxReduceValueBytes, "reduction partial bytes") {
+CudaExecutor::CudaExecutor() : partials_((kMaxReduceBlocks + 1) * kMaxReduceValueBytes, "reduction partial bytes") {
   int device = 0, sms = 0;
   FARLIO_CUDA_CHECK(cudaGetDevice(&device));
   FARLIO_CUDA_CHECK(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device));

@@ -2,7 +2,6 @@
 // The kernels behind CudaExecutor::for_each and ::reduce (nvcc only). The bodies are the shared
 // FARLIO_HD functions, called from __device__ lambdas (--extended-lambda).
 #include <cub/block/block_reduce.cuh>
-
 #include <type_traits>
 
 #include "farlio/cuda/cuda_executor.hpp"
@@ -53,7 +52,8 @@ inline unsigned blocks_for(std::size_t n, unsigned threads, unsigned max_blocks)
 template <typename Body>
 void CudaExecutor::for_each(std::size_t n, const Body& body) {
   if (n == 0) return;
-  detail::for_each_kernel<<<detail::blocks_for(n, kForEachThreads, max_blocks_), kForEachThreads, 0, stream_>>>(n, body);
+  detail::for_each_kernel<<<detail::blocks_for(n, kForEachThreads, max_blocks_), kForEachThreads, 0, stream_>>>(n,
+                                                                                                                body);
   FARLIO_CUDA_CHECK(cudaGetLastError());
 }
 

@@ -1,9 +1,8 @@
-#include "farlio/cuda/cuda_scan_backend.hpp"
-
 #include <algorithm>
 #include <string>
 
 #include "farlio/cuda/cuda_executor.cuh"
+#include "farlio/cuda/cuda_scan_backend.hpp"
 #include "farlio/cuda/device_algorithms.hpp"
 #include "farlio/cuda/device_buffer.hpp"
 #include "farlio/cuda/device_voxel_map.hpp"
@@ -29,8 +28,10 @@ std::size_t checked_size(std::int64_t value, const char* name) {
 
 /// Items of the shared work arrays: the largest input of any update, plus one.
 std::size_t scratch_items(const Config& c) {
-  return std::max({checked_size(c.cuda.max_scan_points, kScanParameter), checked_size(c.cuda.max_map_voxels, kMapParameter),
-                   checked_size(c.cuda.max_frame_voxels, kFrameMapParameter)}) + 1;
+  return std::max({checked_size(c.cuda.max_scan_points, kScanParameter),
+                   checked_size(c.cuda.max_map_voxels, kMapParameter),
+                   checked_size(c.cuda.max_frame_voxels, kFrameMapParameter)}) +
+         1;
 }
 
 }  // namespace
@@ -102,8 +103,10 @@ class CudaScanBackend final : public pipeline::ScanBackend {
     frame_map_.clear();
     frame_map_.insert(frame_.data(), frame_size_, Eigen::Vector3f::Zero(),
                       map::PointLimit::constant(config_.density.frame_map_max_points_per_voxel));
-    source_size_ = frame_map_.gather(source_points_.data(), source_covs_.data(), source_points_.capacity(), kScanParameter);
-    pipeline::SourceSummary out{source_size_, frame_map_.mean_points_per_voxel(Eigen::Vector3f::Zero(), density_range_m)};
+    source_size_ =
+        frame_map_.gather(source_points_.data(), source_covs_.data(), source_points_.capacity(), kScanParameter);
+    pipeline::SourceSummary out{source_size_,
+                                frame_map_.mean_points_per_voxel(Eigen::Vector3f::Zero(), density_range_m)};
     timer_.stop(StageTimer::kSource);
     return out;
   }
@@ -111,8 +114,8 @@ class CudaScanBackend final : public pipeline::ScanBackend {
   registration::RegistrationResult register_source(const SE3& initial_guess, const registration::Thresholds& th,
                                                    const RegistrationConfig& config, double time_budget_s) override {
     timer_.start(StageTimer::kRegistration);
-    const auto result = registration::gauss_newton(
-        [&](const SE3& T) { return linear_system(T, th, config); }, initial_guess, config, time_budget_s);
+    const auto result = registration::gauss_newton([&](const SE3& T) { return linear_system(T, th, config); },
+                                                   initial_guess, config, time_budget_s);
     timer_.stop(StageTimer::kRegistration);
     return result;
   }

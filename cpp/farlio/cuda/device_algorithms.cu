@@ -1,30 +1,27 @@
-#include "farlio/cuda/device_algorithms.hpp"
-
+#include <algorithm>
 #include <cub/device/device_radix_sort.cuh>
 #include <cub/device/device_scan.cuh>
 #include <cub/device/device_select.cuh>
-
-#include <algorithm>
 #include <limits>
+
+#include "farlio/cuda/device_algorithms.hpp"
 
 namespace farlio::cuda {
 namespace {
 
 std::size_t sort_bytes(std::size_t n) {
   std::size_t bytes = 0;
-  FARLIO_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, bytes, static_cast<const std::uint64_t*>(nullptr),
-                                                    static_cast<std::uint64_t*>(nullptr),
-                                                    static_cast<const std::int32_t*>(nullptr),
-                                                    static_cast<std::int32_t*>(nullptr), static_cast<int>(n)));
+  FARLIO_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(
+      nullptr, bytes, static_cast<const std::uint64_t*>(nullptr), static_cast<std::uint64_t*>(nullptr),
+      static_cast<const std::int32_t*>(nullptr), static_cast<std::int32_t*>(nullptr), static_cast<int>(n)));
   return bytes;
 }
 
 std::size_t select_bytes(std::size_t n) {
   std::size_t bytes = 0;
-  FARLIO_CUDA_CHECK(cub::DeviceSelect::Flagged(nullptr, bytes, static_cast<const std::int32_t*>(nullptr),
-                                               static_cast<const std::uint8_t*>(nullptr),
-                                               static_cast<std::int32_t*>(nullptr), static_cast<std::int32_t*>(nullptr),
-                                               static_cast<int>(n)));
+  FARLIO_CUDA_CHECK(cub::DeviceSelect::Flagged(
+      nullptr, bytes, static_cast<const std::int32_t*>(nullptr), static_cast<const std::uint8_t*>(nullptr),
+      static_cast<std::int32_t*>(nullptr), static_cast<std::int32_t*>(nullptr), static_cast<int>(n)));
   return bytes;
 }
 

@@ -68,7 +68,8 @@ DeviceVoxelMap::DeviceVoxelMap(const VoxelMapConfig& config, std::size_t voxel_c
 
 void DeviceVoxelMap::reconfigure(const VoxelMapConfig& config) {
   if (config.max_points_per_voxel != config_.max_points_per_voxel) {
-    throw std::invalid_argument("DeviceVoxelMap::reconfigure: max_points_per_voxel cannot change (buffers are preallocated)");
+    throw std::invalid_argument(
+        "DeviceVoxelMap::reconfigure: max_points_per_voxel cannot change (buffers are preallocated)");
   }
   validate_config(config);
   config_ = config;
@@ -78,11 +79,9 @@ void DeviceVoxelMap::reconfigure(const VoxelMapConfig& config) {
 
 template <typename View, typename Self>
 View DeviceVoxelMap::view_of(Self& self) {
-  const VoxelMapConfig& c = self.config_;
-  return {self.slot_keys_.data(),  self.slot_voxels_.data(),  self.slot_keys_.capacity(),
-          self.voxel_keys_.data(), self.voxel_counts_.data(), self.points_.data(),
-          self.covs_.data(),       c.max_points_per_voxel,    static_cast<float>(c.voxel_size_m),
-          static_cast<float>(1.0 / c.voxel_size_m)};
+  return map::make_map_view<View>(self.slot_keys_.data(), self.slot_voxels_.data(), self.slot_keys_.capacity(),
+                                  self.voxel_keys_.data(), self.voxel_counts_.data(), self.points_.data(),
+                                  self.covs_.data(), self.config_.max_points_per_voxel, self.config_.voxel_size_m);
 }
 
 map::MapView DeviceVoxelMap::view() { return view_of<map::MapView>(*this); }
@@ -185,8 +184,8 @@ map::InsertStats DeviceVoxelMap::insert(const Eigen::Vector3f* points, std::size
   map::GroupStats* gstats = s.group_stats.data();
   ex.for_each(groups, [=] __device__(std::size_t g) {
     const auto candidate = [=](std::int64_t c) { return points[order[c]]; };
-    gstats[g] = map::insert_voxel_group(v, group_voxel[g], candidate, group_start[g], group_start[g + 1], ip,
-                                        &first_new[g]);
+    gstats[g] =
+        map::insert_voxel_group(v, group_voxel[g], candidate, group_start[g], group_start[g + 1], ip, &first_new[g]);
   });
   const bool refresh = config_.refresh_covariances;
   const InsertTotals totals = ex.reduce(

@@ -37,15 +37,15 @@ FARLIO_HD double neighbourhood_bytes(const map::ConstMapView& m, const Eigen::Ve
   constexpr double kSlotBytes = sizeof(std::uint64_t) + sizeof(std::int32_t);
   constexpr double kPointBytes = sizeof(Eigen::Vector4f);
   double bytes = 0.0;
-  map::for_each_nearby_voxel(m, p, [=] { return bound2; }, [&](std::int32_t v) {
-    bytes += kSlotBytes + sizeof(std::int32_t) + kPointBytes * m.voxel_counts[v];
-  });
+  map::for_each_nearby_voxel(
+      m, p, [=] { return bound2; },
+      [&](std::int32_t v) { bytes += kSlotBytes + sizeof(std::int32_t) + kPointBytes * m.voxel_counts[v]; });
   return bytes;
 }
 
 /// Bytes asked for by searches around R * points[i] + t within bound2, the queries included.
-double search_bytes(CudaExecutor& ex, const map::ConstMapView& m, const Eigen::Vector4f* points, std::size_t n, float bound2,
-                    const Eigen::Matrix3f& R, const Eigen::Vector3f& t) {
+double search_bytes(CudaExecutor& ex, const map::ConstMapView& m, const Eigen::Vector4f* points, std::size_t n,
+                    float bound2, const Eigen::Matrix3f& R, const Eigen::Vector3f& t) {
   return ex.reduce(
       n, 0.0,
       [=] __device__(std::size_t i) {
@@ -68,8 +68,8 @@ void knn_kernel(CudaExecutor& ex, const map::ConstMapView& m, const Eigen::Vecto
   });
 }
 
-void reduction_kernel(CudaExecutor& ex, const map::ConstMapView& m, const Eigen::Vector4f* points, const map::Cov3* covs,
-                      std::size_t n, const registration::FactorParams& fp) {
+void reduction_kernel(CudaExecutor& ex, const map::ConstMapView& m, const Eigen::Vector4f* points,
+                      const map::Cov3* covs, std::size_t n, const registration::FactorParams& fp) {
   ex.reduce(
       n, registration::FactorSums::zero(),
       [=] __device__(std::size_t i) { return registration::factor_sums(m, points[i], covs[i], fp); },
@@ -89,15 +89,15 @@ BandwidthSample measure_copy(CudaExecutor& ex, std::size_t bytes, int repeats) {
   return s;
 }
 
-BandwidthSample measure_knn(CudaExecutor& ex, const map::ConstMapView& m, const Eigen::Vector4f* points, std::size_t n, int k,
-                            float max_distance2, int repeats) {
+BandwidthSample measure_knn(CudaExecutor& ex, const map::ConstMapView& m, const Eigen::Vector4f* points, std::size_t n,
+                            int k, float max_distance2, int repeats) {
   DeviceBuffer<std::int64_t> idx(n * static_cast<std::size_t>(k), "k-NN results");
   DeviceBuffer<float> d2(n * static_cast<std::size_t>(k), "k-NN results");
   DeviceBuffer<int> found(n, "k-NN results");
   const auto per = static_cast<std::size_t>(k);
-  BandwidthSample s{"k-NN (k=" + std::to_string(k) + ")", 0.0, search_bytes(ex, m, points, n, max_distance2,
-                                                                               Eigen::Matrix3f::Identity(),
-                                                                               Eigen::Vector3f::Zero())};
+  BandwidthSample s{
+      "k-NN (k=" + std::to_string(k) + ")", 0.0,
+      search_bytes(ex, m, points, n, max_distance2, Eigen::Matrix3f::Identity(), Eigen::Vector3f::Zero())};
   s.bytes += static_cast<double>(n * (sizeof(int) + per * (sizeof(std::int64_t) + sizeof(float))));  // results
   s.ms = median_ms(ex, repeats,
                    [&] { knn_kernel(ex, m, points, n, k, max_distance2, found.data(), idx.data(), d2.data()); });
@@ -107,7 +107,8 @@ BandwidthSample measure_knn(CudaExecutor& ex, const map::ConstMapView& m, const 
 BandwidthSample measure_gicp_reduction(CudaExecutor& ex, const map::ConstMapView& m, const Eigen::Vector4f* points,
                                        const map::Cov3* covs, std::size_t n, float max_distance2, const SE3& pose,
                                        int repeats) {
-  registration::FactorParams fp = registration::factor_params(pose, registration::Thresholds::from_sigma(1.0), RegistrationConfig{});
+  registration::FactorParams fp =
+      registration::factor_params(pose, registration::Thresholds::from_sigma(1.0), RegistrationConfig{});
   fp.max_correspondence_distance2 = max_distance2;
   BandwidthSample s{"GICP reduction", 0.0, search_bytes(ex, m, points, n, max_distance2, fp.R, fp.t)};
   s.bytes += static_cast<double>(n * sizeof(map::Cov3));

@@ -31,8 +31,8 @@ BandwidthSample measure_knn(CudaExecutor& executor, const map::ConstMapView& tar
 
 /// One GICP linear system of n device source points against `target` at `pose` with
 /// correspondences within sqrt(max_distance2).
-BandwidthSample measure_gicp_reduction(CudaExecutor& executor, const map::ConstMapView& target, const Eigen::Vector4f* points,
-                                       const map::Cov3* covs, std::size_t n, float max_distance2, const SE3& pose,
-                                       int repeats);
+BandwidthSample measure_gicp_reduction(CudaExecutor& executor, const map::ConstMapView& target,
+                                       const Eigen::Vector4f* points, const map::Cov3* covs, std::size_t n,
+                                       float max_distance2, const SE3& pose, int repeats);
 
 }  // namespace farlio::cuda

@@ -20,10 +20,10 @@ struct MapScratch {
   DeviceBuffer<std::int32_t> iota;          ///< 0, 1, 2, ... (filled once)
   DeviceBuffer<std::int32_t> sorted_order;  ///< input index of each sorted key
   DeviceBuffer<std::uint8_t> flags;
-  DeviceBuffer<std::int32_t> group_start;   ///< sorted position of each group's first key, then the end
+  DeviceBuffer<std::int32_t> group_start;  ///< sorted position of each group's first key, then the end
   DeviceBuffer<std::int32_t> group_voxel, missing, rank, first_new;
   DeviceBuffer<map::GroupStats> group_stats;
-  DeviceBuffer<std::int32_t> scalars;       ///< small device-side results (see map_scratch.cu)
+  DeviceBuffer<std::int32_t> scalars;  ///< small device-side results (see map_scratch.cu)
 
   [[nodiscard]] std::size_t memory_bytes() const;
 };

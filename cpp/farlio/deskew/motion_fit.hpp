@@ -12,6 +12,7 @@
 namespace farlio::deskew {
 
 /// Needs at least two samples with distinct tau; otherwise returns the identity motion.
-ScanMotion fit_scan_motion(const std::vector<std::pair<double, SE3>>& sensor_poses_at_tau, const SE3& sensor_pose_at_end);
+ScanMotion fit_scan_motion(const std::vector<std::pair<double, SE3>>& sensor_poses_at_tau,
+                           const SE3& sensor_pose_at_end);
 
 }  // namespace farlio::deskew

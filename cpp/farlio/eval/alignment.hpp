@@ -2,9 +2,8 @@
 // Least-squares alignment of two corresponding point sets (Umeyama 1991): the rigid transform
 // (optionally with a uniform scale, i.e. Sim(3)) that minimises
 //   sum_k | target_k - (scale * R * source_k + t) |^2 .
-#include <span>
-
 #include <Eigen/Core>
+#include <span>
 
 #include "farlio/core/se3.hpp"
 

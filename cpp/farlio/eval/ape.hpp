@@ -14,11 +14,11 @@
 namespace farlio::eval {
 
 struct ApeResult {
-  Alignment alignment;             ///< estimate -> ground-truth frame
-  ErrorStats translation_m;        ///< after alignment
-  ErrorStats rotation_deg;         ///< after alignment
-  ErrorStats translation_raw_m;    ///< without alignment
-  ErrorStats rotation_raw_deg;     ///< without alignment
+  Alignment alignment;                       ///< estimate -> ground-truth frame
+  ErrorStats translation_m;                  ///< after alignment
+  ErrorStats rotation_deg;                   ///< after alignment
+  ErrorStats translation_raw_m;              ///< without alignment
+  ErrorStats rotation_raw_deg;               ///< without alignment
   std::vector<double> translation_errors_m;  ///< per pair, after alignment
   std::vector<double> rotation_errors_deg;   ///< per pair, after alignment
   std::vector<SE3> aligned_estimate;         ///< the estimate poses after alignment

@@ -11,7 +11,6 @@
 namespace farlio::eval {
 namespace {
 
-
 /// Index of the stamp in sorted `stamps` nearest to t (earlier one on a tie); stamps non-empty.
 std::size_t nearest_index(const std::vector<std::int64_t>& stamps, std::int64_t t) {
   const auto it = std::lower_bound(stamps.begin(), stamps.end(), t);
@@ -47,7 +46,6 @@ std::optional<SE3> interpolate_within_gap(const Trajectory& gt, const std::vecto
 }
 
 }  // namespace
-
 
 AssociatedPoses associate(const Trajectory& estimate, const Trajectory& groundtruth,
                           const AssociationOptions& options) {

@@ -30,8 +30,8 @@ enum class AssociationMode { kInterpolate, kNearest };
 
 struct AssociationOptions {
   AssociationMode mode = AssociationMode::kInterpolate;
-  double max_time_diff_s = kDefaultMaxTimeDiff_s;      ///< tolerance of a nearest-stamp match
-  double max_gt_gap_s = kDefaultMaxGroundTruthGap_s;   ///< longest ground-truth gap interpolated over
+  double max_time_diff_s = kDefaultMaxTimeDiff_s;     ///< tolerance of a nearest-stamp match
+  double max_gt_gap_s = kDefaultMaxGroundTruthGap_s;  ///< longest ground-truth gap interpolated over
 };
 
 /// Associated pose pairs, in estimate order; index k of every vector refers to the same pair.

@@ -29,11 +29,11 @@ struct EvaluationResult {
   std::size_t estimate_poses = 0;
   std::size_t groundtruth_poses = 0;
   std::size_t associated_poses = 0;
-  double coverage = 0.0;                      ///< fraction of scan stamps with an estimate pose
-  double groundtruth_path_length_m = 0.0;     ///< along the associated ground-truth poses
-  std::vector<std::int64_t> stamps_ns;        ///< stamps of the associated pairs
-  std::vector<SE3> groundtruth;               ///< associated ground-truth poses
-  ApeResult ape;                              ///< includes the aligned estimate poses
+  double coverage = 0.0;                   ///< fraction of scan stamps with an estimate pose
+  double groundtruth_path_length_m = 0.0;  ///< along the associated ground-truth poses
+  std::vector<std::int64_t> stamps_ns;     ///< stamps of the associated pairs
+  std::vector<SE3> groundtruth;            ///< associated ground-truth poses
+  ApeResult ape;                           ///< includes the aligned estimate poses
   KittiRpeResult kitti_rpe;
   DeltaRpeResult rpe;
 };

@@ -33,7 +33,7 @@ struct DeltaRpeOptions {
   DeltaUnit unit = DeltaUnit::kFrames;
   bool all_pairs = false;
   double rel_delta_tol = kDefaultRelativeDeltaTolerance;  ///< metres, all pairs only
-  bool pairs_from_groundtruth = true;  ///< measure metres along the ground truth (evo: estimate)
+  bool pairs_from_groundtruth = true;                     ///< measure metres along the ground truth (evo: estimate)
 };
 
 using IndexPair = std::pair<std::size_t, std::size_t>;

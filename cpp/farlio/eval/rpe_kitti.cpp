@@ -45,7 +45,7 @@ KittiRpeResult compute_kitti_rpe(std::span<const SE3> estimate, std::span<const 
   const double path_m = dist.empty() ? 0.0 : dist.back();
 
   KittiRpeResult r;
-  r.segment_lengths_m = !options.segment_lengths_m.empty()        ? options.segment_lengths_m
+  r.segment_lengths_m = !options.segment_lengths_m.empty()         ? options.segment_lengths_m
                         : path_m >= options.short_path_threshold_m ? kitti_segment_lengths_m()
                                                                    : short_segment_lengths_m();
   double t_sum = 0.0, r_sum = 0.0;

@@ -30,7 +30,7 @@ std::vector<double> short_segment_lengths_m();
 
 struct KittiRpeOptions {
   std::size_t step_frames = kDefaultKittiStepFrames;
-  std::vector<double> segment_lengths_m;                ///< empty: chosen by path length (see above)
+  std::vector<double> segment_lengths_m;  ///< empty: chosen by path length (see above)
   double short_path_threshold_m = kShortPathThreshold_m;
 };
 

@@ -14,8 +14,7 @@ namespace farlio::exec {
 class CpuExecutor {
  public:
   /// num_threads <= 0: all hardware threads.
-  explicit CpuExecutor(int num_threads = 0)
-      : arena_(num_threads > 0 ? num_threads : tbb::task_arena::automatic) {}
+  explicit CpuExecutor(int num_threads = 0) : arena_(num_threads > 0 ? num_threads : tbb::task_arena::automatic) {}
 
   [[nodiscard]] int num_threads() const { return arena_.max_concurrency(); }
 

@@ -2,9 +2,8 @@
 // Detects an accelerometer that reports in g instead of m/s^2: the mean |a| of the first samples
 // (taken at rest or in ordinary driving, where |a| is close to gravity) is compared with both
 // hypotheses on a log scale, i.e. against the geometric midpoint sqrt(g) between 1 and g.
-#include <string>
-
 #include <Eigen/Core>
+#include <string>
 
 namespace farlio::fusion {
 

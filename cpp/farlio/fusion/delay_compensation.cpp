@@ -17,8 +17,7 @@ ArrivalResidual arrival_residual(MeasurementKind kind, const Eigen::VectorXd& z_
   if (history.empty() || stamp_ns < history.oldest().stamp_ns) {
     out.rejection_reason = "measurement stamp " + std::to_string(stamp_ns) +
                            " ns is older than the state history (oldest " +
-                           (history.empty() ? std::string("none") : std::to_string(history.oldest().stamp_ns)) +
-                           " ns)";
+                           (history.empty() ? std::string("none") : std::to_string(history.oldest().stamp_ns)) + " ns)";
     return out;
   }
   const Eigen::VectorXd h_now = measure(kind, x_now);

@@ -16,12 +16,11 @@
 // the measurement about ten times.)
 // Without delay compensation, each injection's residual is z_s - h(x) at the injection step,
 // i.e. the measurement is treated as if taken now.
+#include <Eigen/Core>
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "farlio/fusion/kinematic_ekf.hpp"
 #include "farlio/fusion/state_history.hpp"
@@ -53,8 +52,8 @@ class SpreadMeasurementQueue {
   explicit SpreadMeasurementQueue(bool delay_compensation) : compensate_(delay_compensation) {}
 
   /// Queues a measurement: residual = its arrival residual, R its covariance, injections = N >= 1.
-  void add(MeasurementKind kind, const Eigen::VectorXd& z_s, const Eigen::VectorXd& residual,
-           const Eigen::MatrixXd& R, int injections);
+  void add(MeasurementKind kind, const Eigen::VectorXd& z_s, const Eigen::VectorXd& residual, const Eigen::MatrixXd& R,
+           int injections);
   /// Fuses one injection of every queued measurement (call once per EKF step, after the
   /// prediction); returns how many injections were applied.
   int inject(KinematicEkf& ekf);

@@ -1,9 +1,10 @@
 #include "farlio/fusion/imu_buffer.hpp"
-#include "farlio/core/time.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <vector>
+
+#include "farlio/core/time.hpp"
 
 namespace farlio::fusion {
 namespace {
@@ -38,8 +39,7 @@ ImuReading ImuBuffer::value(std::int64_t stamp_ns, bool from_left) const {
     if (a.stamp_ns - before.stamp_ns > gap_limit_ns_) return reading_of(before, true);
   }
   const double s = static_cast<double>(stamp_ns - a.stamp_ns) / static_cast<double>(b.stamp_ns - a.stamp_ns);
-  return {a.gyro_rad_s + s * (b.gyro_rad_s - a.gyro_rad_s), a.accel_m_s2 + s * (b.accel_m_s2 - a.accel_m_s2),
-          false};
+  return {a.gyro_rad_s + s * (b.gyro_rad_s - a.gyro_rad_s), a.accel_m_s2 + s * (b.accel_m_s2 - a.accel_m_s2), false};
 }
 
 ImuReading ImuBuffer::at(std::int64_t stamp_ns) const { return value(stamp_ns, false); }

@@ -12,7 +12,7 @@ namespace farlio::fusion {
 struct ImuReading {
   Eigen::Vector3d gyro_rad_s = Eigen::Vector3d::Zero();
   Eigen::Vector3d accel = Eigen::Vector3d::Zero();  ///< in the IMU's own unit (see AccelUnitDetector)
-  bool in_gap = false;                               ///< the value is held across a gap
+  bool in_gap = false;                              ///< the value is held across a gap
 };
 
 class ImuBuffer {

@@ -26,8 +26,7 @@ class KinematicEkf {
   /// Updates with the residual r = z - h(x) (angles already wrapped) and covariance R. When
   /// gate_chi2 > 0, the group is rejected (state unchanged, false returned) if its squared
   /// Mahalanobis distance exceeds gate_chi2.
-  bool update(MeasurementKind kind, const Eigen::VectorXd& residual, const Eigen::MatrixXd& R,
-              double gate_chi2 = 0.0);
+  bool update(MeasurementKind kind, const Eigen::VectorXd& residual, const Eigen::MatrixXd& R, double gate_chi2 = 0.0);
 
   [[nodiscard]] const StateVector& state() const { return x_; }
   [[nodiscard]] const StateMatrix& covariance() const { return P_; }

@@ -20,20 +20,14 @@ Eigen::Matrix3d euler_rate_matrix(const Eigen::Vector3d& rpy) {
   const double cp = clamped_cos_pitch(rpy.y()), tp = std::sin(rpy.y()) / cp;
   Eigen::Matrix3d E;
   E << 1.0, sr * tp, cr * tp,  //
-      0.0, cr, -sr,             //
+      0.0, cr, -sr,            //
       0.0, sr / cp, cr / cp;
   return E;
 }
 
-Eigen::Matrix3d rot_x(double a) {
-  return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitX()).toRotationMatrix();
-}
-Eigen::Matrix3d rot_y(double a) {
-  return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitY()).toRotationMatrix();
-}
-Eigen::Matrix3d rot_z(double a) {
-  return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-}
+Eigen::Matrix3d rot_x(double a) { return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitX()).toRotationMatrix(); }
+Eigen::Matrix3d rot_y(double a) { return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitY()).toRotationMatrix(); }
+Eigen::Matrix3d rot_z(double a) { return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()).toRotationMatrix(); }
 
 }  // namespace
 
@@ -80,8 +74,7 @@ ModelJacobians model_jacobians(const StateVector& x, const InputVector& u, doubl
   const double s = sr * w.y() + cr * w.z();
   const double c = cr * w.y() - sr * w.z();
   J.df_dx.block<3, 1>(kAttitudeIndex, kAttitudeIndex + 0) = Eigen::Vector3d(tp * c, -s, c / cp);
-  J.df_dx.block<3, 1>(kAttitudeIndex, kAttitudeIndex + 1) =
-      Eigen::Vector3d(s / (cp * cp), 0.0, s * sp / (cp * cp));
+  J.df_dx.block<3, 1>(kAttitudeIndex, kAttitudeIndex + 1) = Eigen::Vector3d(s / (cp * cp), 0.0, s * sp / (cp * cp));
   J.df_du.block<3, 3>(kAttitudeIndex, kGyroIndex) = euler_rate_matrix(x.segment<3>(kAttitudeIndex));
   // v' = a - w x v + (g sp, -g sr cp, -g cr cp)
   J.df_dx.block<3, 1>(kVelocityIndex, kAttitudeIndex + 0) = Eigen::Vector3d(0.0, -g * cr * cp, g * sr * cp);

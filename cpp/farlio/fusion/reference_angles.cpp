@@ -1,11 +1,11 @@
 #include "farlio/fusion/reference_angles.hpp"
-#include "farlio/core/time.hpp"
 
 #include <Eigen/Geometry>
-
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+
+#include "farlio/core/time.hpp"
 
 namespace farlio::fusion {
 namespace {

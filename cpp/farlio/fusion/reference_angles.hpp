@@ -7,11 +7,10 @@
 // Hann window of `taps` samples around one centre step, so the terms stay time-aligned and the
 // filter has no phase lag about that centre; the result refers to the centre stamp, which lies
 // (taps - 1) / 2 + 1 steps behind the newest sample (the caller fuses it as a delayed measurement).
+#include <Eigen/Core>
 #include <cstdint>
 #include <deque>
 #include <optional>
-
-#include <Eigen/Core>
 
 namespace farlio::fusion {
 
@@ -19,7 +18,7 @@ struct ReferenceAngles {
   std::int64_t stamp_ns = 0;  ///< the stamp the angles refer to (the window centre)
   double roll_rad = 0.0;
   double pitch_rad = 0.0;
-  bool saturated = false;     ///< an asin argument hit the clamp (the angle is a lower bound)
+  bool saturated = false;  ///< an asin argument hit the clamp (the angle is a lower bound)
 };
 
 /// Normalised symmetric Hann weights w_i = sin^2(pi (i + 1) / (taps + 1)), i = 0..taps-1.

@@ -17,7 +17,8 @@ double square(double v) { return v * v; }
 
 InputVector input_variance(const FusionConfig& c) {
   InputVector q;
-  q << Eigen::Vector3d::Constant(square(c.accel_input_std_m_s2)), Eigen::Vector3d::Constant(square(c.gyro_input_std_rad_s));
+  q << Eigen::Vector3d::Constant(square(c.accel_input_std_m_s2)),
+      Eigen::Vector3d::Constant(square(c.gyro_input_std_rad_s));
   return q;
 }
 
@@ -125,9 +126,8 @@ void SensorFusion::fuse_reference_angles(std::int64_t stamp_ns) {
   const Eigen::Vector2d z(angles->roll_rad, angles->pitch_rad);
   const Eigen::Matrix2d R =
       Eigen::Vector2d(square(config_.reference_roll_std_rad), square(config_.reference_pitch_std_rad)).asDiagonal();
-  const ArrivalResidual r =
-      arrival_residual(MeasurementKind::kRollPitch, z, angles->stamp_ns, history_, x, cumulative_correction_,
-                       config_.delay_compensation);
+  const ArrivalResidual r = arrival_residual(MeasurementKind::kRollPitch, z, angles->stamp_ns, history_, x,
+                                             cumulative_correction_, config_.delay_compensation);
   if (!r.residual) return;
   const StateVector before = x;
   if (ekf_.update(MeasurementKind::kRollPitch, *r.residual, R, gate(2))) {
@@ -147,7 +147,8 @@ void SensorFusion::initialize(std::int64_t stamp_ns, const SE3& pose, const Eige
   StateVector variance;
   variance << Eigen::Vector3d::Constant(square(config_.initial_position_std_m)),
       Eigen::Vector3d::Constant(square(config_.initial_attitude_std_rad)),
-      Eigen::Vector3d::Constant(square(velocity_known ? config_.lidar_velocity_std_m_s : config_.initial_velocity_std_m_s));
+      Eigen::Vector3d::Constant(
+          square(velocity_known ? config_.lidar_velocity_std_m_s : config_.initial_velocity_std_m_s));
   ekf_.initialize(x, variance.asDiagonal());
   time_ns_ = stamp_ns;
   history_.clear();

@@ -2,11 +2,10 @@
 // The sensor-fusion front (paper Sec. "Sensor Fusion"): IMU samples in, LiDAR results in, the
 // fused body odometry out. Deterministic and clock-free: time only advances through
 // advance_to(), on a fixed grid of FusionConfig::step_s anchored at the initialisation stamp.
+#include <Eigen/Core>
 #include <cstdint>
 #include <optional>
 #include <string>
-
-#include <Eigen/Core>
 
 #include "farlio/core/config.hpp"
 #include "farlio/core/se3.hpp"
@@ -22,36 +21,36 @@
 namespace farlio::fusion {
 
 struct BodyEstimate {
-  bool valid = false;                    ///< false before initialisation
-  std::int64_t stamp_ns = 0;             ///< the filter time (the last step)
-  SE3 pose;                              ///< body -> world
+  bool valid = false;         ///< false before initialisation
+  std::int64_t stamp_ns = 0;  ///< the filter time (the last step)
+  SE3 pose;                   ///< body -> world
   Eigen::Vector3d velocity_body_m_s = Eigen::Vector3d::Zero();
 };
 
 struct FusionStats {
   std::int64_t steps = 0;
-  std::int64_t lidar_groups_accepted = 0;   ///< position / orientation / velocity groups
-  std::int64_t lidar_groups_rejected = 0;   ///< by the Mahalanobis gate
-  std::int64_t lidar_too_old = 0;           ///< older than the state history: rejected
-  std::int64_t reinitializations = 0;       ///< after max_consecutive_rejections
+  std::int64_t lidar_groups_accepted = 0;  ///< position / orientation / velocity groups
+  std::int64_t lidar_groups_rejected = 0;  ///< by the Mahalanobis gate
+  std::int64_t lidar_too_old = 0;          ///< older than the state history: rejected
+  std::int64_t reinitializations = 0;      ///< after max_consecutive_rejections
   std::int64_t reference_angles_accepted = 0;
   std::int64_t reference_angles_rejected = 0;  ///< gated or saturated
-  std::int64_t imu_gaps = 0;                ///< gap events (each held-input stretch counts once)
-  std::int64_t imu_samples_dropped = 0;     ///< older than the newest sample
-  bool accel_in_g = false;                  ///< the accelerometer was detected to report in g
-  std::string accel_unit_message;           ///< printable note when accel_in_g
+  std::int64_t imu_gaps = 0;                   ///< gap events (each held-input stretch counts once)
+  std::int64_t imu_samples_dropped = 0;        ///< older than the newest sample
+  bool accel_in_g = false;                     ///< the accelerometer was detected to report in g
+  std::string accel_unit_message;              ///< printable note when accel_in_g
   Eigen::Vector3d gyro_bias_rad_s = Eigen::Vector3d::Zero();
   std::int64_t bias_samples = 0;
-  std::string last_warning;                 ///< the most recent warning, empty if none
+  std::string last_warning;  ///< the most recent warning, empty if none
 };
 
 /// Which groups of one LiDAR result were accepted.
 struct LidarUpdateResult {
   bool position_accepted = false;
   bool orientation_accepted = false;
-  bool velocity_accepted = false;  ///< false as well when no velocity was given
-  bool initialized_filter = false; ///< this result (re-)initialised the filter
-  std::string rejection_reason;    ///< set when the whole result was rejected
+  bool velocity_accepted = false;   ///< false as well when no velocity was given
+  bool initialized_filter = false;  ///< this result (re-)initialised the filter
+  std::string rejection_reason;     ///< set when the whole result was rejected
 };
 
 class SensorFusion {

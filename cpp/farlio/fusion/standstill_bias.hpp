@@ -4,10 +4,9 @@
 // small), every gyro reading is a bias sample. The bias is the running mean over a bounded
 // window, with the initial bias counted as `prior_samples` samples so that a few samples cannot
 // swing it. The accelerometer bias is not estimated (it stays at its configured value).
+#include <Eigen/Core>
 #include <cstdint>
 #include <deque>
-
-#include <Eigen/Core>
 
 #include "farlio/core/config.hpp"
 

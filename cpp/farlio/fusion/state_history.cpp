@@ -44,8 +44,10 @@ std::optional<StampedState> StateHistory::entry_at(std::int64_t stamp_ns) const 
   std::size_t lo = 0, hi = size_ - 1;
   while (lo < hi) {
     const std::size_t mid = (lo + hi) / 2;
-    if (at(mid).stamp_ns < stamp_ns) lo = mid + 1;
-    else hi = mid;
+    if (at(mid).stamp_ns < stamp_ns)
+      lo = mid + 1;
+    else
+      hi = mid;
   }
   const StampedState& b = at(lo);
   if (b.stamp_ns == stamp_ns || lo == 0) return b;

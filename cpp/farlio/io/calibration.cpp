@@ -1,4 +1,3 @@
-#include "farlio/io/file_bytes.hpp"
 #include "farlio/io/calibration.hpp"
 
 #include <yaml-cpp/yaml.h>
@@ -7,6 +6,7 @@
 #include <string>
 
 #include "farlio/core/error.hpp"
+#include "farlio/io/file_bytes.hpp"
 #include "farlio/io/rigid_transform.hpp"
 #include "farlio/io/text_number.hpp"
 
@@ -89,8 +89,8 @@ std::string quoted(const std::string& name) {
 }
 
 std::string extrinsics_text(const Calibration& calib) {
-  std::string text = std::string(kExtrinsicKey) +
-                     ":  # 4x4 row-major, maps LiDAR-frame points into the IMU (body) frame";
+  std::string text =
+      std::string(kExtrinsicKey) + ":  # 4x4 row-major, maps LiDAR-frame points into the IMU (body) frame";
   if (calib.T_imu_lidar_by_name.empty()) return text + "\n" + matrix_text(calib.T_imu_lidar, "  ");
   text += ", per LiDAR topic or frame id\n";
   for (const auto& [name, pose] : calib.T_imu_lidar_by_name) {

@@ -22,9 +22,9 @@ struct Calibration {
   /// not empty it replaces T_imu_lidar (which is then unused).
   std::map<std::string, SE3> T_imu_lidar_by_name;
   std::optional<double> gravity_m_s2;  ///< empty: not stated in the file
-  double imu_rate_hz = 0;    ///< 0: not stated
-  double lidar_rate_hz = 0;  ///< 0: not stated
-  std::filesystem::path source;  ///< the file it was read from (empty if made in code), named in errors
+  double imu_rate_hz = 0;              ///< 0: not stated
+  double lidar_rate_hz = 0;            ///< 0: not stated
+  std::filesystem::path source;        ///< the file it was read from (empty if made in code), named in errors
 
   /// gravity_m_s2, or kDefaultGravity_m_s2 when not stated.
   [[nodiscard]] double gravity_or_default() const { return gravity_m_s2.value_or(kDefaultGravity_m_s2); }

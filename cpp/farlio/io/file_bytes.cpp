@@ -85,7 +85,8 @@ void write_file_bytes(const std::filesystem::path& path, std::span<const unsigne
 }
 
 void write_text_file(const std::filesystem::path& path, const std::string& text) {
-  write_file_bytes(path, std::span<const unsigned char>(reinterpret_cast<const unsigned char*>(text.data()), text.size()));
+  write_file_bytes(path,
+                   std::span<const unsigned char>(reinterpret_cast<const unsigned char*>(text.data()), text.size()));
 }
 
 }  // namespace farlio::io

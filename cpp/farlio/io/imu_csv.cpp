@@ -1,4 +1,3 @@
-#include "farlio/io/file_bytes.hpp"
 #include "farlio/io/imu_csv.hpp"
 
 #include <array>
@@ -9,6 +8,7 @@
 #include <string_view>
 
 #include "farlio/core/error.hpp"
+#include "farlio/io/file_bytes.hpp"
 #include "farlio/io/text_number.hpp"
 
 namespace farlio::io {

@@ -28,7 +28,9 @@ Scan read_kitti_bin(const std::filesystem::path& path) {
   scan.intensity.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     const unsigned char* p = bytes.data() + i * kBytesPerPoint;
-    auto at = [&](std::size_t k) { return static_cast<float>(load_scalar(p + k * sizeof(float), kFloat32, kLittleEndian)); };
+    auto at = [&](std::size_t k) {
+      return static_cast<float>(load_scalar(p + k * sizeof(float), kFloat32, kLittleEndian));
+    };
     scan.points[i] = Vec3f(at(0), at(1), at(2));
     scan.intensity[i] = at(3);
   }

@@ -7,13 +7,13 @@
 namespace farlio::io {
 namespace {
 
-constexpr std::size_t kMaxLiteralRun = 32;         // control byte 0..31
-constexpr std::size_t kMinMatch = 3;               // shortest back-reference worth encoding
-constexpr std::size_t kLengthBias = 2;             // encoded length = match length - 2
-constexpr std::size_t kShortLengthMax = 7;         // (c >> 5) == 7: an extra length byte follows
+constexpr std::size_t kMaxLiteralRun = 32;                              // control byte 0..31
+constexpr std::size_t kMinMatch = 3;                                    // shortest back-reference worth encoding
+constexpr std::size_t kLengthBias = 2;                                  // encoded length = match length - 2
+constexpr std::size_t kShortLengthMax = 7;                              // (c >> 5) == 7: an extra length byte follows
 constexpr std::size_t kMaxMatch = kShortLengthMax + 255 + kLengthBias;  // 264
 constexpr std::size_t kMaxDistance = std::size_t{1} << 13;              // 8192 (13-bit distance - 1)
-constexpr unsigned kLiteralLimit = 32;             // control bytes below this are literal runs
+constexpr unsigned kLiteralLimit = 32;                                  // control bytes below this are literal runs
 constexpr unsigned kLengthShift = 5;
 constexpr unsigned kDistanceHighMask = 0x1f;
 constexpr unsigned kHashBits = 14;
@@ -83,8 +83,8 @@ std::vector<unsigned char> lzf_compress(std::span<const unsigned char> in) {
       const std::size_t h = hash3(&in[ip]);
       const std::size_t ref = table[h];
       table[h] = ip;
-      if (ref != kNoEntry && ip - ref <= kMaxDistance && in[ref] == in[ip] &&
-          in[ref + 1] == in[ip + 1] && in[ref + 2] == in[ip + 2]) {
+      if (ref != kNoEntry && ip - ref <= kMaxDistance && in[ref] == in[ip] && in[ref + 1] == in[ip + 1] &&
+          in[ref + 2] == in[ip + 2]) {
         const std::size_t max_len = std::min(kMaxMatch, n - ip);
         std::size_t len = kMinMatch;
         while (len < max_len && in[ref + len] == in[ip + len]) ++len;

@@ -25,7 +25,6 @@ class LzfError : public std::runtime_error {
 
 /// Decompresses `in`, which must expand to exactly `expected_size` bytes. Throws LzfError on a
 /// reference before the start of the output, a chunk running past the input, or a size mismatch.
-[[nodiscard]] std::vector<unsigned char> lzf_decompress(std::span<const unsigned char> in,
-                                                        std::size_t expected_size);
+[[nodiscard]] std::vector<unsigned char> lzf_decompress(std::span<const unsigned char> in, std::size_t expected_size);
 
 }  // namespace farlio::io

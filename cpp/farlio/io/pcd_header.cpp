@@ -15,10 +15,14 @@ constexpr std::size_t kViewpointValues = 7;  // tx ty tz qw qx qy qz
 
 std::optional<ScalarType> pcd_type(std::string_view letter, std::size_t size) {
   ScalarType t;
-  if (letter == "F") t.kind = ScalarKind::Float;
-  else if (letter == "I") t.kind = ScalarKind::Int;
-  else if (letter == "U") t.kind = ScalarKind::Uint;
-  else return std::nullopt;
+  if (letter == "F")
+    t.kind = ScalarKind::Float;
+  else if (letter == "I")
+    t.kind = ScalarKind::Int;
+  else if (letter == "U")
+    t.kind = ScalarKind::Uint;
+  else
+    return std::nullopt;
   t.size_bytes = size;
   if (!t.is_valid()) return std::nullopt;
   return t;
@@ -59,9 +63,7 @@ class HeaderParser {
   }
 
  private:
-  [[noreturn]] void fail(const std::string& what) const {
-    throw InputError(file_ + ": " + what);
-  }
+  [[noreturn]] void fail(const std::string& what) const { throw InputError(file_ + ": " + what); }
 
   std::size_t to_size(std::string_view key, std::string_view tok) const {
     const auto v = parse_int64(tok);
@@ -108,7 +110,8 @@ class HeaderParser {
     } else if (key == "DATA") {
       if (tokens.size() != 2) fail("DATA needs exactly one value");
       const auto enc = parse_pcd_encoding(tokens[1]);
-      if (!enc) fail("unknown DATA encoding '" + std::string(tokens[1]) + "' (expected ascii, binary or binary_compressed)");
+      if (!enc)
+        fail("unknown DATA encoding '" + std::string(tokens[1]) + "' (expected ascii, binary or binary_compressed)");
       h_.encoding = *enc;
       return true;
     } else {
@@ -126,8 +129,8 @@ class HeaderParser {
     const std::size_t nf = names_.size();
     if (count_.empty()) count_.assign(nf, 1);
     if (size_.size() != nf || types_.size() != nf || count_.size() != nf) {
-      fail("FIELDS lists " + std::to_string(nf) + " fields but SIZE has " + std::to_string(size_.size()) +
-           ", TYPE " + std::to_string(types_.size()) + " and COUNT " + std::to_string(count_.size()) + " values");
+      fail("FIELDS lists " + std::to_string(nf) + " fields but SIZE has " + std::to_string(size_.size()) + ", TYPE " +
+           std::to_string(types_.size()) + " and COUNT " + std::to_string(count_.size()) + " values");
     }
     for (std::size_t k = 0; k < nf; ++k) {
       const auto type = pcd_type(types_[k], size_[k]);
@@ -170,9 +173,7 @@ std::size_t PcdHeader::record_bytes() const {
   return b;
 }
 
-PcdHeader parse_pcd_header(const Bytes& bytes, const std::string& file) {
-  return HeaderParser(bytes, file).parse();
-}
+PcdHeader parse_pcd_header(const Bytes& bytes, const std::string& file) { return HeaderParser(bytes, file).parse(); }
 
 std::string format_pcd_header(const std::vector<FieldSpec>& fields, std::size_t points, PcdEncoding encoding) {
   std::ostringstream h;

@@ -16,7 +16,7 @@ struct PcdHeader {
   std::size_t height = 1;
   std::size_t points = 0;
   PcdEncoding encoding = PcdEncoding::Binary;
-  std::size_t data_offset = 0;  ///< first byte after the DATA line
+  std::size_t data_offset = 0;   ///< first byte after the DATA line
   std::size_t header_lines = 0;  ///< lines up to and including the DATA line
 
   /// Bytes of one point (sum of SIZE * COUNT).

@@ -61,7 +61,8 @@ Scan read_ascii(const Bytes& bytes, const PcdHeader& h, const ChannelMap& m, con
     }
     for (auto tok : tokens) {
       const auto v = parse_double(tok);
-      if (!v) throw InputError(file + ": line " + std::to_string(line_no) + ": '" + std::string(tok) + "' is not a number");
+      if (!v)
+        throw InputError(file + ": line " + std::to_string(line_no) + ": '" + std::string(tok) + "' is not a number");
       values.push_back(*v);
     }
     ++got;

@@ -67,10 +67,14 @@ PlyHeader parse_header(const Bytes& bytes, const std::string& file) {
     if (key == "end_header") break;
     if (key == "format") {
       if (tok.size() != 3 || tok[2] != "1.0") fail("expected 'format <type> 1.0'");
-      if (tok[1] == "ascii") h.format = PlyFormat::Ascii;
-      else if (tok[1] == "binary_little_endian") h.format = PlyFormat::BinaryLittle;
-      else if (tok[1] == "binary_big_endian") h.format = PlyFormat::BinaryBig;
-      else fail("unknown format '" + std::string(tok[1]) + "'");
+      if (tok[1] == "ascii")
+        h.format = PlyFormat::Ascii;
+      else if (tok[1] == "binary_little_endian")
+        h.format = PlyFormat::BinaryLittle;
+      else if (tok[1] == "binary_big_endian")
+        h.format = PlyFormat::BinaryBig;
+      else
+        fail("unknown format '" + std::string(tok[1]) + "'");
       format_seen = true;
     } else if (key == "element") {
       if (tok.size() != 3) fail("expected 'element <name> <count>'");
@@ -166,7 +170,8 @@ Scan read_ply(const std::filesystem::path& path) {
   }
   if (vertex == nullptr) throw InputError(file + ": no 'vertex' element");
   std::vector<FieldSpec> fields;
-  for (const auto& p : vertex->properties) fields.push_back({p.name, p.type, p.is_list ? 0u : 1u});  // a list has no fixed count
+  for (const auto& p : vertex->properties)
+    fields.push_back({p.name, p.type, p.is_list ? 0u : 1u});  // a list has no fixed count
   const ChannelMap m = map_channels(fields, file);
 
   PlyCursor cur(bytes, h, file);

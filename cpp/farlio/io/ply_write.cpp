@@ -9,7 +9,8 @@
 
 namespace farlio::io {
 
-void write_ply(const std::filesystem::path& path, const std::vector<Vec3f>& points, const std::vector<float>* intensity) {
+void write_ply(const std::filesystem::path& path, const std::vector<Vec3f>& points,
+               const std::vector<float>* intensity) {
   static_assert(std::endian::native == std::endian::little, "the PLY writer assumes a little endian host");
   const bool with_intensity = intensity != nullptr;
   if (with_intensity && intensity->size() != points.size()) {

@@ -16,7 +16,8 @@ std::optional<std::size_t> find_field(const std::vector<FieldSpec>& fields, std:
 }
 
 template <std::size_t N>
-std::optional<std::size_t> find_first(const std::vector<FieldSpec>& fields, const std::array<std::string_view, N>& names) {
+std::optional<std::size_t> find_first(const std::vector<FieldSpec>& fields,
+                                      const std::array<std::string_view, N>& names) {
   for (auto name : names) {
     if (auto k = find_field(fields, name)) return k;
   }

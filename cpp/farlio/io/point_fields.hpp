@@ -39,8 +39,8 @@ Scan assemble_scan(std::size_t n, const ChannelMap& m, Get&& get) {
   Scan s;
   s.points.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
-    s.points[i] = Vec3f(static_cast<float>(get(i, m.x)), static_cast<float>(get(i, m.y)),
-                        static_cast<float>(get(i, m.z)));
+    s.points[i] =
+        Vec3f(static_cast<float>(get(i, m.x)), static_cast<float>(get(i, m.y)), static_cast<float>(get(i, m.z)));
   }
   if (m.intensity) {
     s.intensity.resize(n);

@@ -28,14 +28,12 @@ bool ScalarType::is_valid() const {
 
 std::optional<ScalarType> ply_scalar_type(const std::string& name) {
   static const std::map<std::string, ScalarType, std::less<>> kTypes = {
-      {"char", {ScalarKind::Int, 1}},     {"int8", {ScalarKind::Int, 1}},
-      {"uchar", {ScalarKind::Uint, 1}},   {"uint8", {ScalarKind::Uint, 1}},
-      {"short", {ScalarKind::Int, 2}},    {"int16", {ScalarKind::Int, 2}},
-      {"ushort", {ScalarKind::Uint, 2}},  {"uint16", {ScalarKind::Uint, 2}},
-      {"int", {ScalarKind::Int, 4}},      {"int32", {ScalarKind::Int, 4}},
-      {"uint", {ScalarKind::Uint, 4}},    {"uint32", {ScalarKind::Uint, 4}},
-      {"float", {ScalarKind::Float, 4}},  {"float32", {ScalarKind::Float, 4}},
-      {"double", {ScalarKind::Float, 8}}, {"float64", {ScalarKind::Float, 8}},
+      {"char", {ScalarKind::Int, 1}},      {"int8", {ScalarKind::Int, 1}},      {"uchar", {ScalarKind::Uint, 1}},
+      {"uint8", {ScalarKind::Uint, 1}},    {"short", {ScalarKind::Int, 2}},     {"int16", {ScalarKind::Int, 2}},
+      {"ushort", {ScalarKind::Uint, 2}},   {"uint16", {ScalarKind::Uint, 2}},   {"int", {ScalarKind::Int, 4}},
+      {"int32", {ScalarKind::Int, 4}},     {"uint", {ScalarKind::Uint, 4}},     {"uint32", {ScalarKind::Uint, 4}},
+      {"float", {ScalarKind::Float, 4}},   {"float32", {ScalarKind::Float, 4}}, {"double", {ScalarKind::Float, 8}},
+      {"float64", {ScalarKind::Float, 8}},
   };
   const auto it = kTypes.find(name);
   if (it == kTypes.end()) return std::nullopt;

@@ -50,7 +50,8 @@ SequenceReader::SequenceReader(std::filesystem::path dir) : dir_(std::move(dir))
   }
   if (has_calib_) calib_ = read_calibration(calib_path);
   if (!calib_.T_imu_lidar_by_name.empty()) {
-    throw InputError(calib_path.string() + ": T_imu_lidar is a mapping of several LiDARs; a sequence folder has one "
+    throw InputError(calib_path.string() +
+                     ": T_imu_lidar is a mapping of several LiDARs; a sequence folder has one "
                      "(a 4x4 matrix)");
   }
   if (has_imu_) imu_ = read_imu_csv(imu_path, warnings_);

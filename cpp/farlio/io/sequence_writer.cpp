@@ -16,7 +16,6 @@ namespace {
 
 constexpr std::size_t kKittiNameBytes = 32;  // "%06zu.bin" with room for any size_t
 
-
 }  // namespace
 
 SequenceWriter::SequenceWriter(std::filesystem::path dir) : dir_(std::move(dir)) {
@@ -33,7 +32,9 @@ void SequenceWriter::write_scan(const Scan& scan, PcdEncoding encoding) {
 
 void SequenceWriter::write_imu(const std::vector<ImuSample>& samples) { write_imu_csv(dir_ / "imu.csv", samples); }
 
-void SequenceWriter::write_groundtruth(const Trajectory& body_poses) { write_tum(dir_ / "groundtruth.tum", body_poses); }
+void SequenceWriter::write_groundtruth(const Trajectory& body_poses) {
+  write_tum(dir_ / "groundtruth.tum", body_poses);
+}
 
 void SequenceWriter::write_groundtruth_scans(const Trajectory& body_poses_at_scan_end) {
   write_tum(dir_ / "groundtruth_scans.tum", body_poses_at_scan_end);

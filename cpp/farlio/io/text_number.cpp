@@ -40,7 +40,8 @@ std::string format_number(double v) { return format_float_like(v); }
 std::string format_seconds_from_ns(std::int64_t ns) {
   const bool negative = ns < 0;
   // Work with the magnitude in unsigned arithmetic so INT64_MIN is safe.
-  const std::uint64_t mag = negative ? std::uint64_t(0) - static_cast<std::uint64_t>(ns) : static_cast<std::uint64_t>(ns);
+  const std::uint64_t mag =
+      negative ? std::uint64_t(0) - static_cast<std::uint64_t>(ns) : static_cast<std::uint64_t>(ns);
   const std::uint64_t sec = mag / kNsPerSecond;
   std::string frac = std::to_string(mag % kNsPerSecond);
   frac.insert(0, static_cast<std::size_t>(kNsDecimals) - frac.size(), '0');

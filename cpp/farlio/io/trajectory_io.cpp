@@ -1,4 +1,3 @@
-#include "farlio/io/file_bytes.hpp"
 #include "farlio/io/trajectory_io.hpp"
 
 #include <array>
@@ -8,12 +7,13 @@
 #include <type_traits>
 
 #include "farlio/core/error.hpp"
+#include "farlio/io/file_bytes.hpp"
 #include "farlio/io/text_number.hpp"
 
 namespace farlio::io {
 namespace {
 
-constexpr std::size_t kTumValues = 8;    // t x y z qx qy qz qw
+constexpr std::size_t kTumValues = 8;     // t x y z qx qy qz qw
 constexpr std::size_t kKittiValues = 12;  // 3x4 row-major
 constexpr int kKittiRows = 3;
 constexpr int kKittiCols = 4;
@@ -40,7 +40,6 @@ std::ifstream open_for_reading(const std::filesystem::path& path) {
   if (!in) throw InputError(path.string() + ": cannot open file");
   return in;
 }
-
 
 /// Calls on_values(line_no, tokens) for every non-blank, non-comment line; stops early when
 /// on_values returns false (if it returns a bool).
@@ -104,7 +103,8 @@ Trajectory read_kitti(const std::filesystem::path& path, const std::vector<std::
     }
     Mat4d m = Mat4d::Identity();
     for (int r = 0; r < kKittiRows; ++r) {
-      for (int c = 0; c < kKittiCols; ++c) m(r, c) = number_at(path, line_no, tok[static_cast<std::size_t>(r * kKittiCols + c)]);
+      for (int c = 0; c < kKittiCols; ++c)
+        m(r, c) = number_at(path, line_no, tok[static_cast<std::size_t>(r * kKittiCols + c)]);
     }
     poses.push_back(SE3::from_matrix(m));
   });
@@ -143,8 +143,9 @@ TrajectoryFormat detect_trajectory_format(const std::filesystem::path& path) {
   std::optional<TrajectoryFormat> format;
   for_each_data_line(path, [&](std::size_t line_no, const std::vector<std::string_view>& tok) {
     if (tok.size() != kTumValues && tok.size() != kKittiValues) {
-      bad_line(path, line_no, std::to_string(tok.size()) + " values is neither TUM (" + std::to_string(kTumValues) +
-                                  ") nor KITTI (" + std::to_string(kKittiValues) + ")");
+      bad_line(path, line_no,
+               std::to_string(tok.size()) + " values is neither TUM (" + std::to_string(kTumValues) + ") nor KITTI (" +
+                   std::to_string(kKittiValues) + ")");
     }
     format = tok.size() == kTumValues ? TrajectoryFormat::kTum : TrajectoryFormat::kKitti;
     return false;  // the first data line decides

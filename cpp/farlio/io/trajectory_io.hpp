@@ -39,8 +39,8 @@ void write_kitti(const std::filesystem::path& path, const Trajectory& trajectory
 
 enum class TrajectoryFormat { kAuto, kTum, kKitti };
 /// The names of the formats, as the command line and Python take them.
-inline constexpr std::array<std::pair<std::string_view, TrajectoryFormat>, 3> kTrajectoryFormatNames{{
-    {"auto", TrajectoryFormat::kAuto}, {"tum", TrajectoryFormat::kTum}, {"kitti", TrajectoryFormat::kKitti}}};
+inline constexpr std::array<std::pair<std::string_view, TrajectoryFormat>, 3> kTrajectoryFormatNames{
+    {{"auto", TrajectoryFormat::kAuto}, {"tum", TrajectoryFormat::kTum}, {"kitti", TrajectoryFormat::kKitti}}};
 /// The format called `name` (kTrajectoryFormatNames); nullopt for any other name.
 [[nodiscard]] std::optional<TrajectoryFormat> parse_trajectory_format(std::string_view name);
 

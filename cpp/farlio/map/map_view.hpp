@@ -43,16 +43,35 @@ struct BasicMapView {
 
   /// A mutable view reads as a read-only one (written <!kMutable> so that the read-only view
   /// declares no conversion to its own type).
-  FARLIO_HD operator BasicMapView<!kMutable>() const
-    requires kMutable
-  {
-    return {slot_keys, slot_voxels, table_capacity, voxel_keys, voxel_counts, points, covs,
-            max_points_per_voxel, voxel_size, inv_voxel_size};
+  FARLIO_HD operator BasicMapView<!kMutable>() const requires kMutable {
+    return {slot_keys, slot_voxels, table_capacity,       voxel_keys, voxel_counts,
+            points,    covs,        max_points_per_voxel, voxel_size, inv_voxel_size};
   }
 };
 
 using MapView = BasicMapView<true>;
 using ConstMapView = BasicMapView<false>;
+
+/// The view of an owner's table and pool buffers (VoxelMap's vectors, DeviceVoxelMap's device
+/// buffers) laid out for `max_points_per_voxel` points in voxels of `voxel_size_m`.
+template <typename View>
+View make_map_view(typename View::template Ptr<std::uint64_t> slot_keys,
+                   typename View::template Ptr<std::int32_t> slot_voxels, std::uint64_t table_capacity,
+                   typename View::template Ptr<std::uint64_t> voxel_keys,
+                   typename View::template Ptr<std::int32_t> voxel_counts,
+                   typename View::template Ptr<Eigen::Vector4f> points, typename View::template Ptr<Cov3> covs,
+                   std::int32_t max_points_per_voxel, double voxel_size_m) {
+  return {slot_keys,
+          slot_voxels,
+          table_capacity,
+          voxel_keys,
+          voxel_counts,
+          points,
+          covs,
+          max_points_per_voxel,
+          static_cast<float>(voxel_size_m),
+          static_cast<float>(1.0 / voxel_size_m)};
+}
 
 /// Voxel index stored under `key`, or -1. Probes at most table_capacity slots.
 FARLIO_HD inline std::int32_t table_find(const ConstMapView& m, std::uint64_t key, std::uint64_t hash) {
@@ -71,7 +90,8 @@ FARLIO_HD inline std::int32_t table_find(const ConstMapView& m, const VoxelCoord
 
 /// Inserts key -> voxel if the key is absent (thread-safe; erased slots are not reused here,
 /// the owner rehashes when they pile up). Returns the slot, or -1 when the table is full.
-FARLIO_HD inline std::int64_t table_insert(const MapView& m, std::uint64_t key, std::uint64_t hash, std::int32_t voxel) {
+FARLIO_HD inline std::int64_t table_insert(const MapView& m, std::uint64_t key, std::uint64_t hash,
+                                           std::int32_t voxel) {
   const std::uint64_t mask = m.table_capacity - 1;
   for (std::uint64_t i = 0, s = hash & mask; i < m.table_capacity; ++i, s = (s + 1) & mask) {
     const std::uint64_t prev = exec::atomic_cas(&m.slot_keys[s], kEmptyKey, key);

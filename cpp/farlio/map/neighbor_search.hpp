@@ -47,17 +47,19 @@ FARLIO_HD inline std::int64_t nearest_neighbor(const ConstMapView& m, const Eige
                                                float* distance2 = nullptr) {
   float best = max_distance2;
   std::int64_t best_index = -1;
-  for_each_nearby_voxel(m, p, [&] { return best; }, [&](std::int32_t v) {
-    const std::int32_t n = m.voxel_counts[v];
-    for (std::int32_t j = 0; j < n; ++j) {
-      const std::int64_t idx = m.point_index(v, j);
-      const float d2 = (m.points[idx].head<3>() - p).squaredNorm();
-      if (d2 < best) {
-        best = d2;
-        best_index = idx;
-      }
-    }
-  });
+  for_each_nearby_voxel(
+      m, p, [&] { return best; },
+      [&](std::int32_t v) {
+        const std::int32_t n = m.voxel_counts[v];
+        for (std::int32_t j = 0; j < n; ++j) {
+          const std::int64_t idx = m.point_index(v, j);
+          const float d2 = (m.points[idx].head<3>() - p).squaredNorm();
+          if (d2 < best) {
+            best = d2;
+            best_index = idx;
+          }
+        }
+      });
   if (distance2) *distance2 = best;
   return best_index;
 }

@@ -8,10 +8,10 @@ namespace farlio::map {
 /// The per-voxel point limit for a point at a given distance from the sensor (ASMD, or a
 /// constant). Evaluated per inserted point.
 struct PointLimit {
-  int close_limit = 40;          ///< limit within close_range_m
-  float close_range_m = 0.0f;    ///< beyond it the limit decays linearly
-  float slope_per_m = 0.0f;      ///< points per metre of decay
-  int min_limit = 40;            ///< floor of the decay (k, so covariances stay computable)
+  int close_limit = 40;        ///< limit within close_range_m
+  float close_range_m = 0.0f;  ///< beyond it the limit decays linearly
+  float slope_per_m = 0.0f;    ///< points per metre of decay
+  int min_limit = 40;          ///< floor of the decay (k, so covariances stay computable)
 
   static PointLimit constant(int n) { return {n, 0.0f, 0.0f, n}; }
   FARLIO_HD int at(float distance_m) const {

@@ -18,8 +18,9 @@ constexpr const char* kCapacityParameter = "map.max_voxel_capacity";
 }  // namespace
 
 double point_spacing_m(const VoxelMapConfig& config) {
-  return config.point_spacing_m > 0.0 ? config.point_spacing_m
-                                      : config.voxel_size_m / std::sqrt(static_cast<double>(config.max_points_per_voxel));
+  return config.point_spacing_m > 0.0
+             ? config.point_spacing_m
+             : config.voxel_size_m / std::sqrt(static_cast<double>(config.max_points_per_voxel));
 }
 
 VoxelMap::VoxelMap(const VoxelMapConfig& config, exec::CpuExecutor& executor)
@@ -31,11 +32,9 @@ VoxelMap::VoxelMap(const VoxelMapConfig& config, exec::CpuExecutor& executor)
 
 template <typename View, typename Self>
 View VoxelMap::view_of(Self& self) {
-  const VoxelMapConfig& c = self.config_;
-  return {self.slot_keys_.data(),  self.slot_voxels_.data(),  self.slot_keys_.size(),
-          self.voxel_keys_.data(), self.voxel_counts_.data(), self.points_.data(),
-          self.covs_.data(),       c.max_points_per_voxel,    static_cast<float>(c.voxel_size_m),
-          static_cast<float>(1.0 / c.voxel_size_m)};
+  return make_map_view<View>(self.slot_keys_.data(), self.slot_voxels_.data(), self.slot_keys_.size(),
+                             self.voxel_keys_.data(), self.voxel_counts_.data(), self.points_.data(), self.covs_.data(),
+                             self.config_.max_points_per_voxel, self.config_.voxel_size_m);
 }
 
 MapView VoxelMap::view() { return view_of<MapView>(*this); }
@@ -132,7 +131,9 @@ InsertStats VoxelMap::insert(const std::vector<Eigen::Vector3f>& points, const E
   std::vector<GroupStats> gstats(groups);
   {
     const MapView v = view();
-    const auto candidate = [&](std::int64_t c) { return points[static_cast<std::size_t>(keyed[static_cast<std::size_t>(c)].second)]; };
+    const auto candidate = [&](std::int64_t c) {
+      return points[static_cast<std::size_t>(keyed[static_cast<std::size_t>(c)].second)];
+    };
     executor_->for_each(groups, [&](std::size_t g) {
       gstats[g] = insert_voxel_group(v, group_voxel[g], candidate, static_cast<std::int64_t>(group_start[g]),
                                      static_cast<std::int64_t>(group_start[g + 1]), ip, &first_new[g]);
@@ -148,8 +149,8 @@ InsertStats VoxelMap::insert(const std::vector<Eigen::Vector3f>& points, const E
   std::vector<std::int32_t> cov_voxels;
   std::vector<PointRange> cov_points;
   for (std::size_t g = 0; g < groups; ++g) {
-    const PointRange r =
-        covariance_points(voxel_counts_[static_cast<std::size_t>(group_voxel[g])], first_new[g], config_.refresh_covariances);
+    const PointRange r = covariance_points(voxel_counts_[static_cast<std::size_t>(group_voxel[g])], first_new[g],
+                                           config_.refresh_covariances);
     if (r.size() == 0) continue;
     cov_voxels.push_back(group_voxel[g]);
     cov_points.push_back(r);

@@ -88,14 +88,14 @@ class VoxelMap {
   // hash table
   std::vector<std::uint64_t> slot_keys_;
   std::vector<std::int32_t> slot_voxels_;
-  std::size_t used_slots_ = 0;    // live + erased
+  std::size_t used_slots_ = 0;  // live + erased
   // voxel pool
   std::vector<std::uint64_t> voxel_keys_;  // kEmptyKey when free
   std::vector<std::int32_t> voxel_counts_;
   std::vector<Eigen::Vector4f> points_;
   std::vector<Cov3> covs_;
   std::vector<std::int32_t> free_voxels_;
-  std::size_t high_water_ = 0;   // voxels [0, high_water_) have been used at least once
+  std::size_t high_water_ = 0;  // voxels [0, high_water_) have been used at least once
   std::size_t live_voxels_ = 0;
 };
 

@@ -26,7 +26,7 @@ struct PoolCounts {
   std::size_t high_water = 0;   ///< voxels [0, high_water) have been used at least once
   std::size_t free_voxels = 0;  ///< removed voxels below the high-water mark, reused first
   std::size_t live_voxels = 0;
-  std::size_t used_slots = 0;   ///< table slots holding a key or an erased marker
+  std::size_t used_slots = 0;  ///< table slots holding a key or an erased marker
   std::size_t table_slots = 0;
 };
 

@@ -43,7 +43,7 @@ struct GroupStats {
 struct InsertParams {
   Eigen::Vector3f origin;  ///< the sensor position (the limit depends on the distance to it)
   PointLimit limit;
-  float spacing2;          ///< squared minimum distance between points of a voxel
+  float spacing2;  ///< squared minimum distance between points of a voxel
 };
 
 /// Inserts the candidates candidate(c), c in [begin, end), into `voxel` in that order: a
@@ -96,8 +96,8 @@ inline constexpr float kUnboundedDistance2 = std::numeric_limits<float>::max();
 /// Covariance (eq. 1) of point j of `voxel` from its k nearest neighbours, and its shape in w
 /// (map::PointShape: no covariance with fewer than k neighbours, else surface or line by
 /// `line_ratio`). Reads the points of the 27 voxels around it.
-FARLIO_HD inline void update_point_covariance(const MapView& m, std::int32_t voxel, std::int32_t j, int k, float epsilon,
-                                              float line_ratio) {
+FARLIO_HD inline void update_point_covariance(const MapView& m, std::int32_t voxel, std::int32_t j, int k,
+                                              float epsilon, float line_ratio) {
   std::int64_t idx[kMaxNeighbors];
   float d2[kMaxNeighbors];
   const std::int64_t pi = m.point_index(voxel, j);
@@ -129,7 +129,8 @@ FARLIO_HD inline double voxel_centre_distance2(std::uint64_t key, const Eigen::V
 
 /// Whether remove_far removes the voxel of this pool entry: a live voxel whose centre is farther
 /// than sqrt(radius2) from origin.
-FARLIO_HD inline bool voxel_is_far(std::uint64_t key, const Eigen::Vector3d& origin, double radius2, double voxel_size) {
+FARLIO_HD inline bool voxel_is_far(std::uint64_t key, const Eigen::Vector3d& origin, double radius2,
+                                   double voxel_size) {
   return key != kEmptyKey && voxel_centre_distance2(key, origin, voxel_size) > radius2;
 }
 

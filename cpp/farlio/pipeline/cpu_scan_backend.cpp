@@ -47,7 +47,8 @@ registration::RegistrationResult CpuScanBackend::register_source(const SE3& init
   return registration::register_scan(source_, map_.view(), initial_guess, th, config, time_budget_s, executor_);
 }
 
-map::InsertStats CpuScanBackend::update_map(const SE3& pose, const map::PointLimit& limit, std::size_t* removed_voxels) {
+map::InsertStats CpuScanBackend::update_map(const SE3& pose, const map::PointLimit& limit,
+                                            std::size_t* removed_voxels) {
   std::vector<Eigen::Vector3f> world(frame_.size());
   const Eigen::Matrix3f R = pose.rotation().cast<float>();
   const Eigen::Vector3f t = pose.translation().cast<float>();

@@ -86,7 +86,7 @@ class FusionDriver {
   std::optional<fusion::SensorFusion> fusion_;
   std::vector<ImuSample> startup_imu_;  ///< the first kGravityAlignmentWindow_s, for the start pose
   std::int64_t clock_ns_ = 0;
-  std::int64_t next_output_ns_ = 0;     ///< 0: set by the first IMU sample
+  std::int64_t next_output_ns_ = 0;       ///< 0: set by the first IMU sample
   std::optional<StampedPose> last_body_;  ///< the previous processed scan's body pose
 };
 

@@ -31,8 +31,8 @@ enum class LatencyModel { Measured, Zero, Fixed };
 
 struct ReplayOptions {
   LatencyModel latency = LatencyModel::Measured;
-  double fixed_latency_s = 0.0;   ///< with LatencyModel::Fixed
-  double added_delay_s = 0.0;     ///< added to every result's latency (latency sweeps)
+  double fixed_latency_s = 0.0;  ///< with LatencyModel::Fixed
+  double added_delay_s = 0.0;    ///< added to every result's latency (latency sweeps)
 };
 
 class Odometry {

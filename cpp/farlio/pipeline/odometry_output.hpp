@@ -2,10 +2,9 @@
 // What the LiDAR-inertial odometry reports: one OdometryFrame per scan (what happened to it) and
 // one OdometrySample per fusion step (the 100 Hz output). The replay (odometry.hpp) and the
 // online odometry (online_odometry.hpp) report the same types.
+#include <Eigen/Core>
 #include <cstdint>
 #include <string>
-
-#include <Eigen/Core>
 
 #include "farlio/core/se3.hpp"
 #include "farlio/pipeline/scan_pipeline.hpp"
@@ -14,14 +13,14 @@ namespace farlio::pipeline {
 
 /// What happened to one scan.
 struct OdometryFrame {
-  FrameResult scan;                   ///< the scan pipeline's result (LiDAR pose, timings, ...)
-  SE3 body_pose;                      ///< registered body pose at the scan end
-  bool processed = false;             ///< false: dropped before registration (pipeline busy)
-  bool fused = false;                 ///< the result reached the fusion
-  std::string drop_reason;            ///< why it was not processed or not fused
-  std::int64_t started_ns = 0;        ///< when the pipeline started on it (the odometry's clock)
-  std::int64_t available_ns = 0;      ///< when its result reached the fusion
-  bool guess_from_fusion = false;     ///< initial guess and undistortion came from the fusion
+  FrameResult scan;                ///< the scan pipeline's result (LiDAR pose, timings, ...)
+  SE3 body_pose;                   ///< registered body pose at the scan end
+  bool processed = false;          ///< false: dropped before registration (pipeline busy)
+  bool fused = false;              ///< the result reached the fusion
+  std::string drop_reason;         ///< why it was not processed or not fused
+  std::int64_t started_ns = 0;     ///< when the pipeline started on it (the odometry's clock)
+  std::int64_t available_ns = 0;   ///< when its result reached the fusion
+  bool guess_from_fusion = false;  ///< initial guess and undistortion came from the fusion
 };
 
 /// One sample of the 100 Hz odometry output.

@@ -104,8 +104,7 @@ OdometryFrame OnlineOdometry::process(const Scan& scan) {
   driver_.link(scan, out);
   // without the fusion there is no clock but the scan stamps: the result is ready after its
   // processing time
-  out.available_ns =
-      driver_.inertial() ? driver_.clock_ns() : out.started_ns + seconds_to_ns(out.scan.timings.total_s);
+  out.available_ns = driver_.inertial() ? driver_.clock_ns() : out.started_ns + seconds_to_ns(out.scan.timings.total_s);
   return out;
 }
 

@@ -29,12 +29,13 @@ registration::RegistrationResult register_pair(const std::vector<Eigen::Vector3f
   frame.insert(down, Eigen::Vector3f::Zero(), map::PointLimit::constant(frame_cfg.max_points_per_voxel));
 
   const auto src = registration::source_from_map(frame.view(), frame.voxel_capacity());
-  return registration::register_scan(src, target_map.view(), initial_guess,
-                                     registration::Thresholds::from_sigma(
-                                         config.threshold.initial_threshold_m,
-                                         registration::point_to_point_precision(config.registration, config.map.covariance_epsilon,
-                                                                                frame_cfg.point_spacing_m)),
-                                     config.registration, std::numeric_limits<double>::infinity(), executor);
+  return registration::register_scan(
+      src, target_map.view(), initial_guess,
+      registration::Thresholds::from_sigma(
+          config.threshold.initial_threshold_m,
+          registration::point_to_point_precision(config.registration, config.map.covariance_epsilon,
+                                                 frame_cfg.point_spacing_m)),
+      config.registration, std::numeric_limits<double>::infinity(), executor);
 }
 
 }  // namespace farlio::pipeline

@@ -46,7 +46,7 @@ std::vector<std::int32_t> first_of_each_cell(std::vector<std::pair<std::uint64_t
 }
 
 double scene_voxel_size_m(const std::vector<Eigen::Vector3f>& points, const VoxelMapConfig& config) {
-  constexpr std::size_t kStride = 16;      // a subsample is enough for a percentile
+  constexpr std::size_t kStride = 16;  // a subsample is enough for a percentile
   constexpr double kPercentile = 0.9;
   if (!config.auto_voxel_size) return config.voxel_size_m;
   std::vector<float> ranges;

@@ -100,10 +100,11 @@ FrameResult ScanPipeline::process(const Scan& scan, const std::optional<SE3>& in
   if (backend_->map_voxels() > 0 && source.points > 0) {
     // the spacing as the backends' maps hold it (float)
     const auto spacing_m = static_cast<float>(map::point_spacing_m(config_.map));
-    const double p2p = registration::point_to_point_precision(config_.registration, config_.map.covariance_epsilon, spacing_m);
-    out.registration = backend_->register_source(out.initial_guess, registration::Thresholds::from_sigma(out.sigma_m, p2p),
-                                                 config_.registration,
-                                                 config_.registration.time_budget_factor * period_s);
+    const double p2p =
+        registration::point_to_point_precision(config_.registration, config_.map.covariance_epsilon, spacing_m);
+    out.registration =
+        backend_->register_source(out.initial_guess, registration::Thresholds::from_sigma(out.sigma_m, p2p),
+                                  config_.registration, config_.registration.time_budget_factor * period_s);
     out.registered = true;
     pose = out.registration.pose;
     threshold_.update(out.initial_guess.inverse() * pose);

@@ -27,15 +27,15 @@
 namespace farlio::pipeline {
 
 struct FrameResult {
-  std::int64_t stamp_ns = 0;                 ///< scan end stamp
-  SE3 pose;                                  ///< LiDAR pose in the world at the scan end
-  SE3 initial_guess;                         ///< the guess the registration started from
-  Eigen::Vector3d velocity_body_m_s = Eigen::Vector3d::Zero();       ///< eq. (6)
+  std::int64_t stamp_ns = 0;                                    ///< scan end stamp
+  SE3 pose;                                                     ///< LiDAR pose in the world at the scan end
+  SE3 initial_guess;                                            ///< the guess the registration started from
+  Eigen::Vector3d velocity_body_m_s = Eigen::Vector3d::Zero();  ///< eq. (6)
   Eigen::Vector3d angular_velocity_body_rad_s = Eigen::Vector3d::Zero();
   registration::RegistrationResult registration;
-  bool registered = false;                   ///< false for the first scan (it starts the map)
-  double sigma_m = 0;                        ///< adaptive threshold used
-  int density_limit = 0;                     ///< close-range per-voxel limit chosen by ASMD
+  bool registered = false;  ///< false for the first scan (it starts the map)
+  double sigma_m = 0;       ///< adaptive threshold used
+  int density_limit = 0;    ///< close-range per-voxel limit chosen by ASMD
   std::size_t input_points = 0, kept_points = 0, source_points = 0;
   map::InsertStats map_insert;
   std::size_t map_voxels = 0, map_points = 0, removed_voxels = 0;

@@ -14,7 +14,8 @@ double AdaptiveThreshold::sigma_m() const {
 }
 
 double AdaptiveThreshold::update(const SE3& deviation) {
-  const double error = deviation.translation().norm() + 2.0 * config_.max_range_m * std::sin(0.5 * deviation.angle_rad());
+  const double error =
+      deviation.translation().norm() + 2.0 * config_.max_range_m * std::sin(0.5 * deviation.angle_rad());
   if (error > config_.min_motion_m) {
     sum_squared_error_ += error * error;
     num_samples_ += 1.0;

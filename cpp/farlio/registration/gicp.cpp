@@ -10,7 +10,8 @@ namespace farlio::registration {
 
 double point_to_point_precision(const RegistrationConfig& config, double covariance_epsilon, double spacing_m) {
   constexpr double kSigmaPerSpacing = 0.5;  // the matched sample may lie up to half a spacing away
-  const double sigma_m = config.point_to_point_sigma_m > 0.0 ? config.point_to_point_sigma_m : kSigmaPerSpacing * spacing_m;
+  const double sigma_m =
+      config.point_to_point_sigma_m > 0.0 ? config.point_to_point_sigma_m : kSigmaPerSpacing * spacing_m;
   const double sigma2 = sigma_m * sigma_m;
   return sigma2 > 0.0 ? covariance_epsilon / sigma2 : 1.0;
 }
@@ -40,8 +41,7 @@ FactorParams factor_params(const SE3& T, const Thresholds& th, const Registratio
 }
 
 LinearSystem build_linear_system(const SourceCloud& source, const map::ConstMapView& target, const SE3& T,
-                                 const Thresholds& th, const RegistrationConfig& config,
-                                 exec::CpuExecutor& executor) {
+                                 const Thresholds& th, const RegistrationConfig& config, exec::CpuExecutor& executor) {
   const FactorParams fp = factor_params(T, th, config);
   const FactorSums sum = executor.reduce(
       source.size(), FactorSums::zero(),
@@ -52,9 +52,8 @@ LinearSystem build_linear_system(const SourceCloud& source, const map::ConstMapV
 RegistrationResult register_scan(const SourceCloud& source, const map::ConstMapView& target, const SE3& initial_guess,
                                  const Thresholds& th, const RegistrationConfig& config, double time_budget_s,
                                  exec::CpuExecutor& executor) {
-  return gauss_newton(
-      [&](const SE3& T) { return build_linear_system(source, target, T, th, config, executor); },
-      initial_guess, config, time_budget_s);
+  return gauss_newton([&](const SE3& T) { return build_linear_system(source, target, T, th, config, executor); },
+                      initial_guess, config, time_budget_s);
 }
 
 RegistrationResult gauss_newton(const SystemBuilder& build, const SE3& initial_guess, const RegistrationConfig& config,

@@ -23,8 +23,8 @@ struct SourceCloud {
 };
 
 struct RegistrationResult {
-  SE3 pose;                      ///< registered sensor pose in the map frame
-  LinearSystem system;           ///< the system of the last iteration (at the pose before its step)
+  SE3 pose;             ///< registered sensor pose in the map frame
+  LinearSystem system;  ///< the system of the last iteration (at the pose before its step)
   int iterations = 0;
   bool converged = false;        ///< |dx| fell below the convergence norm
   bool budget_exceeded = false;  ///< stopped by the time budget
@@ -56,8 +56,7 @@ double point_to_point_precision(const RegistrationConfig& config, double covaria
 
 /// The linear system of `source` at pose T against the map.
 LinearSystem build_linear_system(const SourceCloud& source, const map::ConstMapView& target, const SE3& T,
-                                 const Thresholds& th, const RegistrationConfig& config,
-                                 exec::CpuExecutor& executor);
+                                 const Thresholds& th, const RegistrationConfig& config, exec::CpuExecutor& executor);
 
 RegistrationResult register_scan(const SourceCloud& source, const map::ConstMapView& target, const SE3& initial_guess,
                                  const Thresholds& th, const RegistrationConfig& config, double time_budget_s,

@@ -7,8 +7,8 @@
 //   Omega = lambda I               otherwise (Sigma_r = I / lambda, Sigma_s = 0: point-to-point;
 //                                  the paper's lambda is 1, farlio's the map spacing's),
 // and by the Cauchy weight of |r|. A pair of two line-like covariances is left out with
-// skip_line_pairs. Plain ICP (sparsity_aware false) uses Omega = I for every pair. The Jacobian of r under a right perturbation
-// T exp(delta), delta = [rho; phi], is J = [R, -R [s]x].
+// skip_line_pairs. Plain ICP (sparsity_aware false) uses Omega = I for every pair. The Jacobian of r under a right
+// perturbation T exp(delta), delta = [rho; phi], is J = [R, -R [s]x].
 #include <Eigen/Core>
 #include <Eigen/LU>
 

@@ -11,7 +11,9 @@ struct CauchyKernel {
   float kappa_m = 1.0f;
 
   FARLIO_HD float weight(float residual2) const { return 1.0f / (1.0f + residual2 / (kappa_m * kappa_m)); }
-  FARLIO_HD float cost(float residual2) const { return 0.5f * kappa_m * kappa_m * log1pf(residual2 / (kappa_m * kappa_m)); }
+  FARLIO_HD float cost(float residual2) const {
+    return 0.5f * kappa_m * kappa_m * log1pf(residual2 / (kappa_m * kappa_m));
+  }
 };
 
 }  // namespace farlio::registration

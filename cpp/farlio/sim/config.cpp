@@ -14,7 +14,7 @@ struct ProfileDefaults {
 
 ProfileDefaults defaults_of(Profile p) {
   switch (p) {
-    case Profile::Racetrack:  // engine and kerb vibration: high IMU noise
+    case Profile::Racetrack:      // engine and kerb vibration: high IMU noise
       return {85.0, 20.0, 800.0,  // 2 s rest, standing start and one lap take 82.7 s
               NoiseConfig{0.02, 0.02, 0.02, 0.5, 2e-4, 2e-3, Eigen::Vector3d(0.003, -0.002, 0.001),
                           Eigen::Vector3d(0.08, -0.05, 0.06)}};

@@ -15,12 +15,12 @@ Profile parse_profile(const std::string& name);
 std::string profile_name(Profile profile);
 
 struct NoiseConfig {
-  double range_noise_std_m = 0.0;          ///< Gaussian, along the ray
-  double dropout_probability = 0.0;        ///< chance that a ray returns nothing
-  double gyro_noise_std_rad_s = 0.0;       ///< white noise per sample
-  double accel_noise_std_m_s2 = 0.0;       ///< white noise per sample
-  double gyro_bias_walk_rad_s2_sqrt_hz = 0.0;   ///< bias random walk density
-  double accel_bias_walk_m_s3_sqrt_hz = 0.0;    ///< bias random walk density
+  double range_noise_std_m = 0.0;              ///< Gaussian, along the ray
+  double dropout_probability = 0.0;            ///< chance that a ray returns nothing
+  double gyro_noise_std_rad_s = 0.0;           ///< white noise per sample
+  double accel_noise_std_m_s2 = 0.0;           ///< white noise per sample
+  double gyro_bias_walk_rad_s2_sqrt_hz = 0.0;  ///< bias random walk density
+  double accel_bias_walk_m_s3_sqrt_hz = 0.0;   ///< bias random walk density
   Eigen::Vector3d gyro_bias_initial_rad_s = Eigen::Vector3d::Zero();
   Eigen::Vector3d accel_bias_initial_m_s2 = Eigen::Vector3d::Zero();
 };

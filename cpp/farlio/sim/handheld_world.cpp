@@ -44,10 +44,10 @@ void build_floor_plan(Scene& scene) {
   wall(scene, 0, 0, 0, 8);
   wall(scene, 10, 0, 10, 3);
   wall(scene, 10, 5, 10, 8);
-  furniture(scene, 4.5, 5.2, 1.4, 0.7, 0.75, 0.5F);   // table
-  furniture(scene, 6.0, 7.7, 2.0, 0.4, 2.0, 0.7F);    // cabinet
-  furniture(scene, 3.0, 0.25, 1.5, 0.3, 1.8, 0.4F);   // shelf
-  furniture(scene, 9.5, 6.5, 0.8, 1.6, 0.9, 0.3F);    // sofa end
+  furniture(scene, 4.5, 5.2, 1.4, 0.7, 0.75, 0.5F);  // table
+  furniture(scene, 6.0, 7.7, 2.0, 0.4, 2.0, 0.7F);   // cabinet
+  furniture(scene, 3.0, 0.25, 1.5, 0.3, 1.8, 0.4F);  // shelf
+  furniture(scene, 9.5, 6.5, 0.8, 1.6, 0.9, 0.3F);   // sofa end
   scene.add(Cylinder{{5.0, 2.8}, 0.25, 0.0, kCeiling_m, 0.6F});
   // The corridor: 60 m of plain, parallel walls.
   wall(scene, 10, 3, 70, 3);
@@ -82,7 +82,7 @@ SmoothCurve look_around(const std::vector<std::pair<double, double>>& stops) {
 }  // namespace
 
 World build_handheld_world() {
-  const std::vector<Eigen::Vector2d> route = {{2, 1.5}, {8, 1.5}, {8, 6.5},  {2, 6.5},  {2, 4},  {77, 4},
+  const std::vector<Eigen::Vector2d> route = {{2, 1.5}, {8, 1.5}, {8, 6.5}, {2, 6.5}, {2, 4}, {77, 4},
                                               {77, 10}, {82, 10}, {82, -2}, {72, -2}, {72, 1}};
   Path path = Path::from_polyline(route, std::vector<double>(route.size() - 2, kTurnRadius_m), false);
   SpeedPlan plan(path, {kWalkSpeed_m_s, kMaxLateralAccel_m_s2, kMaxLongitudinalAccel_m_s2, kInitialRest_s},

@@ -2,8 +2,8 @@
 
 #include <cmath>
 
-#include "farlio/sim/random.hpp"
 #include "farlio/core/time.hpp"
+#include "farlio/sim/random.hpp"
 
 namespace farlio::sim {
 namespace {

@@ -20,7 +20,9 @@ Eigen::Vector3d euler_zyx_body_rate(const EulerZyx& e) {
 }
 
 VehicleMotion::VehicleMotion(Path path, SpeedPlan plan, SmoothCurve ground_height_of_x_m, double body_height_m)
-    : path_(std::move(path)), plan_(std::move(plan)), ground_(std::move(ground_height_of_x_m)),
+    : path_(std::move(path)),
+      plan_(std::move(plan)),
+      ground_(std::move(ground_height_of_x_m)),
       body_height_m_(body_height_m) {}
 
 BodyState VehicleMotion::state(double t_s) const {
@@ -63,7 +65,8 @@ BodyState WalkerMotion::state(double t_s) const {
   BodyState st;
   const double z = style_.eye_height_m + style_.bob_amplitude_m * std::sin(phase);
   const double dz = style_.bob_amplitude_m * std::cos(phase) * wv;
-  const double d2z = -style_.bob_amplitude_m * std::sin(phase) * wv * wv + style_.bob_amplitude_m * std::cos(phase) * wa;
+  const double d2z =
+      -style_.bob_amplitude_m * std::sin(phase) * wv * wv + style_.bob_amplitude_m * std::cos(phase) * wa;
   const Eigen::Vector3d t3(pp.tangent.x(), pp.tangent.y(), 0.0), n3(pp.normal.x(), pp.normal.y(), 0.0);
   st.velocity_world_m_s = pr.v_m_s * t3 + Eigen::Vector3d(0, 0, dz);
   st.acceleration_world_m_s2 =

@@ -55,10 +55,10 @@ class VehicleMotion final : public MotionModel {
 /// it stops when the walker stands still).
 struct WalkStyle {
   double eye_height_m = 0.0;
-  double stride_m = 0.0;            ///< one vertical bob per stride
+  double stride_m = 0.0;  ///< one vertical bob per stride
   double bob_amplitude_m = 0.0;
-  double pitch_sway_rad = 0.0;      ///< nodding, once per stride
-  double roll_sway_rad = 0.0;       ///< side to side, once per two strides
+  double pitch_sway_rad = 0.0;  ///< nodding, once per stride
+  double roll_sway_rad = 0.0;   ///< side to side, once per two strides
 };
 
 /// A person walking a path while turning the sensor: yaw = path heading + yaw_offset(t).

@@ -20,7 +20,7 @@ struct PathCorner {
 struct PathPoint {
   Eigen::Vector2d position_m = Eigen::Vector2d::Zero();
   double heading_rad = 0.0;
-  double curvature_1_m = 0.0;       ///< signed, positive = left turn
+  double curvature_1_m = 0.0;  ///< signed, positive = left turn
   Eigen::Vector2d tangent = Eigen::Vector2d::UnitX();
   Eigen::Vector2d normal = Eigen::Vector2d::UnitY();  ///< tangent rotated +90 degrees
 };

@@ -40,7 +40,8 @@ std::optional<RayHit> Box::intersect(const Eigen::Vector3d& origin, const Eigen:
   if (t_near < kMinRange_m || t_near > max_range_m) return std::nullopt;
   Eigen::Vector3d n_local = Eigen::Vector3d::Zero();
   n_local[axis] = 1.0;
-  return RayHit{t_near, Eigen::Vector3d(c * n_local.x() - s * n_local.y(), s * n_local.x() + c * n_local.y(), n_local.z()),
+  return RayHit{t_near,
+                Eigen::Vector3d(c * n_local.x() - s * n_local.y(), s * n_local.x() + c * n_local.y(), n_local.z()),
                 reflectivity};
 }
 

@@ -27,7 +27,8 @@ constexpr double kFenceGapChance = 0.12;
 constexpr double kPostOffset_m = 8.8, kPostSpacingMin_m = 20.0, kPostSpacingMax_m = 60.0;
 constexpr double kPostRadiusMin_m = 0.12, kPostRadiusMax_m = 0.3, kPostHeightMin_m = 4.0, kPostHeightMax_m = 8.0;
 constexpr double kBoardSpacingMin_m = 60.0, kBoardSpacingMax_m = 180.0;
-constexpr double kBoardHeightMin_m = 1.5, kBoardHeightMax_m = 3.0, kBoardHalfWidthMin_m = 0.5, kBoardHalfWidthMax_m = 1.5;
+constexpr double kBoardHeightMin_m = 1.5, kBoardHeightMax_m = 3.0, kBoardHalfWidthMin_m = 0.5,
+                 kBoardHalfWidthMax_m = 1.5;
 constexpr double kBoardHalfDepth_m = 0.4, kBoardYawJitter_rad = 0.3;
 constexpr double kTrunkRadius_m = 0.25, kTrunkHeight_m = 3.0, kCrownRadiusMin_m = 1.5, kCrownRadiusMax_m = 3.0;
 constexpr double kCrownTopMin_m = 6.0, kCrownTopMax_m = 12.0;
@@ -53,15 +54,15 @@ void add_segment_box(Scene& scene, const Eigen::Vector2d& a, const Eigen::Vector
 }
 
 /// A wall following the path at a signed lateral offset, as chords of step_m.
-void add_wall_along(Scene& scene, const Path& path, double offset_m, double step_m, double height_m,
-                    double thickness_m, float reflectivity, double gap_chance, Rng& rng) {
+void add_wall_along(Scene& scene, const Path& path, double offset_m, double step_m, double height_m, double thickness_m,
+                    float reflectivity, double gap_chance, Rng& rng) {
   const int n = static_cast<int>(std::ceil(path.length_m() / step_m));
   for (int i = 0; i < n; ++i) {
     const double s0 = path.length_m() * i / n, s1 = path.length_m() * (i + 1) / n;
     if (gap_chance > 0.0 && rng.chance(gap_chance)) continue;
     const PathPoint p0 = path.at(s0), p1 = path.at(s1);
-    add_segment_box(scene, p0.position_m + offset_m * p0.normal, p1.position_m + offset_m * p1.normal, 0.0,
-                    height_m, thickness_m, reflectivity);
+    add_segment_box(scene, p0.position_m + offset_m * p0.normal, p1.position_m + offset_m * p1.normal, 0.0, height_m,
+                    thickness_m, reflectivity);
   }
 }
 
@@ -74,18 +75,22 @@ bool clear_of_track(const Path& path, const Eigen::Vector2d& c) {
 
 void add_trackside_objects(Scene& scene, const Path& path, Rng& rng) {
   for (const double side : {-1.0, 1.0}) {
-    for (double s = rng.uniform(0.0, kPostSpacingMax_m); s < path.length_m(); s += rng.uniform(kPostSpacingMin_m, kPostSpacingMax_m)) {
+    for (double s = rng.uniform(0.0, kPostSpacingMax_m); s < path.length_m();
+         s += rng.uniform(kPostSpacingMin_m, kPostSpacingMax_m)) {
       const PathPoint p = path.at(s);
       const Eigen::Vector2d c = p.position_m + side * kPostOffset_m * p.normal;
       scene.add(Cylinder{c, rng.uniform(kPostRadiusMin_m, kPostRadiusMax_m), 0.0,
                          rng.uniform(kPostHeightMin_m, kPostHeightMax_m), kPostReflectivity});
     }
-    for (double s = rng.uniform(0.0, kBoardSpacingMax_m); s < path.length_m(); s += rng.uniform(kBoardSpacingMin_m, kBoardSpacingMax_m)) {
+    for (double s = rng.uniform(0.0, kBoardSpacingMax_m); s < path.length_m();
+         s += rng.uniform(kBoardSpacingMin_m, kBoardSpacingMax_m)) {
       const PathPoint p = path.at(s);
       const Eigen::Vector2d c = p.position_m + side * kPostOffset_m * p.normal;
       const double h = rng.uniform(kBoardHeightMin_m, kBoardHeightMax_m);
-      scene.add(Box{Eigen::Vector3d(c.x(), c.y(), 0.5 * h), Eigen::Vector3d(rng.uniform(kBoardHalfWidthMin_m, kBoardHalfWidthMax_m), kBoardHalfDepth_m, 0.5 * h),
-                    p.heading_rad + rng.uniform(-kBoardYawJitter_rad, kBoardYawJitter_rad), kBoardReflectivity});
+      scene.add(
+          Box{Eigen::Vector3d(c.x(), c.y(), 0.5 * h),
+              Eigen::Vector3d(rng.uniform(kBoardHalfWidthMin_m, kBoardHalfWidthMax_m), kBoardHalfDepth_m, 0.5 * h),
+              p.heading_rad + rng.uniform(-kBoardYawJitter_rad, kBoardYawJitter_rad), kBoardReflectivity});
     }
     for (double s = 0.0; s < path.length_m(); s += kTreeSpacing_m) {
       if (!rng.chance(kTreeChance)) continue;
@@ -109,8 +114,8 @@ void add_buildings(Scene& scene) {
     for (int k = 0; k < kSteps; ++k) {
       const double h = kStandBaseHeight_m + kStepRise_m * k;
       const double y = -(kStandFront_m + kStepDepth_m * (k + 0.5));
-      scene.add(Box{Eigen::Vector3d(x_center, y, 0.5 * h), Eigen::Vector3d(kStandHalfLength_m, 0.5 * kStepDepth_m, 0.5 * h),
-                    0.0, kStandReflectivity});
+      scene.add(Box{Eigen::Vector3d(x_center, y, 0.5 * h),
+                    Eigen::Vector3d(kStandHalfLength_m, 0.5 * kStepDepth_m, 0.5 * h), 0.0, kStandReflectivity});
     }
   }
   // Pit building x in [-270, 170], y in [16, 32]; garage walls stick out of its front to y = 12.
@@ -129,7 +134,7 @@ void add_buildings(Scene& scene) {
 }  // namespace
 
 World build_racetrack_world() {
-  const std::vector<Eigen::Vector2d> vertices = {{-600, 0},  {600, 0},   {800, 250},  {800, 740}, {500, 770},
+  const std::vector<Eigen::Vector2d> vertices = {{-600, 0},  {600, 0},   {800, 250},  {800, 740},  {500, 770},
                                                  {420, 560}, {200, 620}, {-300, 620}, {-700, 400}, {-780, 150}};
   // Radii in travel order: corners at vertices 1, 2, ..., 9, 0.
   const std::vector<double> radii = {120, 250, 60, 45, 45, 80, 150, 90, 70, 100};
@@ -138,10 +143,14 @@ World build_racetrack_world() {
 
   World w;
   Rng rng(kLayoutSeed);
-  add_wall_along(w.scene, path, kBarrierOffset_m, kBarrierStep_m, kBarrierHeight_m, kBarrierThickness_m, kBarrierReflectivity, 0.0, rng);
-  add_wall_along(w.scene, path, -kBarrierOffset_m, kBarrierStep_m, kBarrierHeight_m, kBarrierThickness_m, kBarrierReflectivity, 0.0, rng);
-  add_wall_along(w.scene, path, kFenceOffset_m, kFenceStep_m, kFenceHeight_m, kFenceThickness_m, kFenceReflectivity, kFenceGapChance, rng);
-  add_wall_along(w.scene, path, -kFenceOffset_m, kFenceStep_m, kFenceHeight_m, kFenceThickness_m, kFenceReflectivity, kFenceGapChance, rng);
+  add_wall_along(w.scene, path, kBarrierOffset_m, kBarrierStep_m, kBarrierHeight_m, kBarrierThickness_m,
+                 kBarrierReflectivity, 0.0, rng);
+  add_wall_along(w.scene, path, -kBarrierOffset_m, kBarrierStep_m, kBarrierHeight_m, kBarrierThickness_m,
+                 kBarrierReflectivity, 0.0, rng);
+  add_wall_along(w.scene, path, kFenceOffset_m, kFenceStep_m, kFenceHeight_m, kFenceThickness_m, kFenceReflectivity,
+                 kFenceGapChance, rng);
+  add_wall_along(w.scene, path, -kFenceOffset_m, kFenceStep_m, kFenceHeight_m, kFenceThickness_m, kFenceReflectivity,
+                 kFenceGapChance, rng);
   add_trackside_objects(w.scene, path, rng);
   add_buildings(w.scene);
   w.scene.build_index(kGridCell_m);
@@ -151,13 +160,17 @@ World build_racetrack_world() {
   w.facts["first_lap_time_s"] = std::to_string(plan.plan_duration_s());  // rest + standing start + lap
   w.facts["initial_rest_s"] = std::to_string(kInitialRest_s);
   w.facts["lidar"] = "3 raster LiDARs (front, left, right), 120 deg x 128 channels x 570 columns each";
-  w.motion = std::make_shared<VehicleMotion>(std::move(path), std::move(plan), SmoothCurve({0.0}, {0.0}), kBodyHeight_m);
+  w.motion =
+      std::make_shared<VehicleMotion>(std::move(path), std::move(plan), SmoothCurve({0.0}, {0.0}), kBodyHeight_m);
   w.T_imu_lidar = mount_pose({0.6, 0.0, 0.5}, 0.01, 0.02, -0.005);
   const auto elevations = uniform_elevations_rad(kChannels, kLowestElevation_rad, kHighestElevation_rad);
   const double yaw_side = kFov_rad;  // the side sensors continue where the front one ends
-  w.lidars.push_back(raster_lidar(0, mount_pose({0.4, 0.0, 0.0}, 0.0, 0.0, 0.0), elevations, kColumns, kFov_rad, kMinRange_m, kMaxRange_m));
-  w.lidars.push_back(raster_lidar(1, mount_pose({0.0, 0.3, 0.0}, yaw_side, 0.0, 0.0), elevations, kColumns, kFov_rad, kMinRange_m, kMaxRange_m));
-  w.lidars.push_back(raster_lidar(2, mount_pose({0.0, -0.3, 0.0}, -yaw_side, 0.0, 0.0), elevations, kColumns, kFov_rad, kMinRange_m, kMaxRange_m));
+  w.lidars.push_back(raster_lidar(0, mount_pose({0.4, 0.0, 0.0}, 0.0, 0.0, 0.0), elevations, kColumns, kFov_rad,
+                                  kMinRange_m, kMaxRange_m));
+  w.lidars.push_back(raster_lidar(1, mount_pose({0.0, 0.3, 0.0}, yaw_side, 0.0, 0.0), elevations, kColumns, kFov_rad,
+                                  kMinRange_m, kMaxRange_m));
+  w.lidars.push_back(raster_lidar(2, mount_pose({0.0, -0.3, 0.0}, -yaw_side, 0.0, 0.0), elevations, kColumns, kFov_rad,
+                                  kMinRange_m, kMaxRange_m));
   return w;
 }
 

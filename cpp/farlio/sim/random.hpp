@@ -9,8 +9,15 @@
 namespace farlio::sim {
 
 /// Independent random streams of one sequence.
-enum class Stream : std::uint64_t { Layout = 1, LidarRange = 2, LidarDropout = 3, ImuGyro = 4, ImuAccel = 5,
-                                    ImuGyroBias = 6, ImuAccelBias = 7 };
+enum class Stream : std::uint64_t {
+  Layout = 1,
+  LidarRange = 2,
+  LidarDropout = 3,
+  ImuGyro = 4,
+  ImuAccel = 5,
+  ImuGyroBias = 6,
+  ImuAccelBias = 7
+};
 
 /// SplitMix64 finaliser: a bijective 64-bit mixer.
 constexpr std::uint64_t mix64(std::uint64_t x) {

@@ -39,7 +39,8 @@ void Scene::build_index(double cell_size_m) {
   for (const auto& b : bounds) {
     const Eigen::Vector4i r = cell_range(b);
     for (int y = r[1]; y <= r[3]; ++y)
-      for (int x = r[0]; x <= r[2]; ++x) ++counts[static_cast<std::size_t>(y) * static_cast<std::size_t>(nx_) + static_cast<std::size_t>(x)];
+      for (int x = r[0]; x <= r[2]; ++x)
+        ++counts[static_cast<std::size_t>(y) * static_cast<std::size_t>(nx_) + static_cast<std::size_t>(x)];
   }
   cell_begin_.assign(counts.size(), 0);
   for (std::size_t c = 1; c < counts.size(); ++c) cell_begin_[c] = cell_begin_[c - 1] + counts[c - 1];
@@ -49,7 +50,8 @@ void Scene::build_index(double cell_size_m) {
     const Eigen::Vector4i r = cell_range(bounds[id]);
     for (int y = r[1]; y <= r[3]; ++y)
       for (int x = r[0]; x <= r[2]; ++x)
-        cell_ids_[fill[static_cast<std::size_t>(y) * static_cast<std::size_t>(nx_) + static_cast<std::size_t>(x)]++] = id;
+        cell_ids_[fill[static_cast<std::size_t>(y) * static_cast<std::size_t>(nx_) + static_cast<std::size_t>(x)]++] =
+            id;
   }
 }
 
@@ -59,8 +61,7 @@ std::optional<RayHit> Scene::intersect_primitive(std::uint32_t id, const Eigen::
   return cylinders_[id - boxes_.size()].intersect(origin, dir, max_range_m);
 }
 
-std::optional<RayHit> Scene::cast(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
-                                  double max_range_m) const {
+std::optional<RayHit> Scene::cast(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double max_range_m) const {
   std::optional<RayHit> best = ground_.intersect(origin, dir, max_range_m);
   if (ceiling_) {
     if (auto h = ceiling_->intersect(origin, dir, best ? best->range_m : max_range_m)) best = h;

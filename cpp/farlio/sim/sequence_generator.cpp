@@ -9,9 +9,9 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "farlio/core/time.hpp"
 #include "farlio/sim/imu_model.hpp"
 #include "farlio/sim/random.hpp"
-#include "farlio/core/time.hpp"
 
 namespace farlio::sim {
 namespace {
@@ -103,7 +103,8 @@ Scan SequenceGenerator::scan(std::size_t i) const {
         const auto hit = world_->scene.cast(origin, dir_world, l.max_range_m);
         if (!hit) continue;
         double range_m = hit->range_m;
-        if (!config_.noise_free) range_m += noise.range_noise_std_m * standard_normal(config_.seed, Stream::LidarRange, i, ray);
+        if (!config_.noise_free)
+          range_m += noise.range_noise_std_m * standard_normal(config_.seed, Stream::LidarRange, i, ray);
         if (range_m < l.min_range_m || range_m > l.max_range_m) continue;
         points[ray] = (l.T_lidar_sensor * (range_m * dir_sensor)).cast<float>();
         times[ray] = static_cast<float>(t_rel_s);

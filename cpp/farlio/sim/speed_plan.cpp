@@ -18,7 +18,9 @@ class Planner {
  public:
   Planner(double v0, double a_lon) : v_(v0), a_lon_(a_lon) { curve_.add_knot(0.0, v0); }
 
-  [[nodiscard]] double ramp_time_s(double v0, double v1) const { return kSmoothstepPeakSlope * std::abs(v1 - v0) / a_lon_; }
+  [[nodiscard]] double ramp_time_s(double v0, double v1) const {
+    return kSmoothstepPeakSlope * std::abs(v1 - v0) / a_lon_;
+  }
   [[nodiscard]] double ramp_distance_m(double v0, double v1) const { return 0.5 * (v0 + v1) * ramp_time_s(v0, v1); }
 
   void ramp_to(double v1) {

@@ -101,12 +101,14 @@ void add_street_furniture(Scene& scene, const GroundProfile& g, Rng& rng) {
         };
         const double yaw = along_x ? 0.0 : 0.5 * std::numbers::pi;
         for (const double side : {-1.0, 1.0}) {
-          for (double u = a_m + kCarClearance_m; u + kCarSlot_m < a_m + kBlockPitch_m - kCarClearance_m; u += kCarSlot_m) {
+          for (double u = a_m + kCarClearance_m; u + kCarSlot_m < a_m + kBlockPitch_m - kCarClearance_m;
+               u += kCarSlot_m) {
             if (!rng.chance(kCarChance)) continue;
             const Eigen::Vector2d p = xy(u + 0.5 * kCarSlot_m, side * kCarOffset_m);
             const double z = g.height_m(p.x()) - kCarSink_m + kCarHalfHeight_m;
-            scene.add(Box{Eigen::Vector3d(p.x(), p.y(), z), Eigen::Vector3d(kCarHalfLength_m, kCarHalfWidth_m, kCarHalfHeight_m), yaw + rng.uniform(-0.05, 0.05),
-                          static_cast<float>(rng.uniform(0.2, 0.9))});
+            scene.add(Box{Eigen::Vector3d(p.x(), p.y(), z),
+                          Eigen::Vector3d(kCarHalfLength_m, kCarHalfWidth_m, kCarHalfHeight_m),
+                          yaw + rng.uniform(-0.05, 0.05), static_cast<float>(rng.uniform(0.2, 0.9))});
           }
           for (double u = a_m + kBuildingSetback_m; u < a_m + kBlockPitch_m - kBuildingSetback_m; u += kPoleSpacing_m) {
             const Eigen::Vector2d p = xy(u + rng.uniform(0.0, 0.3 * kPoleSpacing_m), side * kPoleOffset_m);
@@ -115,7 +117,8 @@ void add_street_furniture(Scene& scene, const GroundProfile& g, Rng& rng) {
           }
           for (double u = a_m + kBuildingSetback_m; u < a_m + kBlockPitch_m - kBuildingSetback_m; u += kTreeSpacing_m) {
             if (!rng.chance(kTreeChance)) continue;
-            const Eigen::Vector2d p = xy(u + rng.uniform(0.0, kTreeSpacing_m - kBuildingSetback_m), side * kTreeOffset_m);
+            const Eigen::Vector2d p =
+                xy(u + rng.uniform(0.0, kTreeSpacing_m - kBuildingSetback_m), side * kTreeOffset_m);
             const double z0 = g.height_m(p.x());
             scene.add(Cylinder{p, kTrunkRadius_m, z0 - kFoundationDepth_m, z0 + kTrunkHeight_m, 0.4F});
             scene.add(Cylinder{p, kCrownRadius_m, z0 + kTrunkHeight_m, z0 + kCrownTop_m, 0.3F});
@@ -129,8 +132,8 @@ void add_street_furniture(Scene& scene, const GroundProfile& g, Rng& rng) {
 
 World build_urban_world() {
   const double b = kBlockPitch_m;
-  const std::vector<Eigen::Vector2d> route = {{0, 0}, {3 * b, 0}, {3 * b, 2 * b}, {b, 2 * b},
-                                              {b, 3 * b}, {4 * b, 3 * b}, {4 * b, -b}, {2 * b, -b}};
+  const std::vector<Eigen::Vector2d> route = {{0, 0},     {3 * b, 0},     {3 * b, 2 * b}, {b, 2 * b},
+                                              {b, 3 * b}, {4 * b, 3 * b}, {4 * b, -b},    {2 * b, -b}};
   Path path = Path::from_polyline(route, std::vector<double>(route.size() - 2, kTurnRadius_m), false);
   SpeedPlan plan(path, {kMaxSpeed_m_s, kMaxLateralAccel_m_s2, kMaxLongitudinalAccel_m_s2, kInitialRest_s},
                  {{1, kStopHold_s}, {3, kStopHold_s}, {5, kStopHold_s}});

@@ -19,7 +19,7 @@ struct World {
   Scene scene;
   std::shared_ptr<const MotionModel> motion;
   std::vector<LidarSensor> lidars;
-  SE3 T_imu_lidar;  ///< maps LiDAR-frame points into the body (IMU) frame
+  SE3 T_imu_lidar;                           ///< maps LiDAR-frame points into the body (IMU) frame
   std::map<std::string, std::string> facts;  ///< profile-specific description entries
 };
 

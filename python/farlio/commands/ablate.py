@@ -1,4 +1,5 @@
 """`farlio ablate`: the paper's component ablation (EKF, DC, MU, SA GICP, ASMD) on one recording."""
+
 from __future__ import annotations
 
 import argparse

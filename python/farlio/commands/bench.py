@@ -1,4 +1,5 @@
 """`farlio bench`: whole-frame latency of farlio's scan pipeline next to KISS-ICP, same scans, same run."""
+
 from __future__ import annotations
 
 import argparse
@@ -6,19 +7,32 @@ import json
 from pathlib import Path
 
 from farlio.benchmark import compare, format_table, generated_scans
-from farlio.runner import DEVICES
 from farlio.datasets import open_dataset
+from farlio.runner import DEVICES
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--profile", action="append", choices=["urban", "racetrack", "handheld"],
-                        help="generated scans of this profile (repeatable; default: urban)")
+    parser.add_argument(
+        "--profile",
+        action="append",
+        choices=["urban", "racetrack", "handheld"],
+        help="generated scans of this profile (repeatable; default: urban)",
+    )
     parser.add_argument("--scans", type=int, default=100, help="frames per data set")
-    parser.add_argument("--data", type=Path, action="append", default=[],
-                        help="also a recording (any format farlio run reads; repeatable)")
+    parser.add_argument(
+        "--data",
+        type=Path,
+        action="append",
+        default=[],
+        help="also a recording (any format farlio run reads; repeatable)",
+    )
     parser.add_argument("--threads", type=int, default=0, help="threads for both systems (0: all)")
-    parser.add_argument("--device", choices=DEVICES, default="auto",
-                        help="farlio's backend: auto (the GPU when present, else the CPU with a message), cpu, cuda")
+    parser.add_argument(
+        "--device",
+        choices=DEVICES,
+        default="auto",
+        help="farlio's backend: auto (the GPU when present, else the CPU with a message), cpu, cuda",
+    )
     parser.add_argument("--no-kiss", action="store_true", help="farlio only (KISS-ICP: pip install kiss-icp)")
     parser.add_argument("--out", type=Path, default=None, help="folder for bench.json (optional)")
 
@@ -32,8 +46,7 @@ def run(args: argparse.Namespace) -> int:
     for path in args.data:
         ds = open_dataset(path)
         scans = [ds.scan(i) for i in range(min(len(ds), args.scans))]
-        results[str(path)] = compare(scans, None, threads=args.threads, with_kiss=not args.no_kiss,
-                                     device=args.device)
+        results[str(path)] = compare(scans, None, threads=args.threads, with_kiss=not args.no_kiss, device=args.device)
         print(format_table(str(path), results[str(path)]), flush=True)
     if args.out:
         args.out.mkdir(parents=True, exist_ok=True)

@@ -1,4 +1,5 @@
 """`farlio config`: every parameter with its default and meaning, as a YAML file to edit."""
+
 from __future__ import annotations
 
 import argparse
@@ -19,8 +20,10 @@ def _yaml_scalar(value) -> str:
 
 
 def render() -> str:
-    lines = ["# farlio parameters: dotted names, defaults, units in the names. Pass with --config FILE",
-             "# or one at a time with --set name=value."]
+    lines = [
+        "# farlio parameters: dotted names, defaults, units in the names. Pass with --config FILE",
+        "# or one at a time with --set name=value.",
+    ]
     section = None
     for name, default, doc, valid in _core.Config.fields():
         head, _, leaf = name.rpartition(".")

@@ -1,4 +1,5 @@
 """`farlio eval`: compare a trajectory with ground truth (implementation in farlio.evaluation)."""
+
 from __future__ import annotations
 
 import argparse

@@ -1,4 +1,5 @@
 """`farlio info`: what this build and machine offer."""
+
 from __future__ import annotations
 
 import argparse

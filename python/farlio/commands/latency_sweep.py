@@ -1,4 +1,5 @@
 """`farlio latency-sweep`: APE of the LIO as the scan pipeline's latency grows (paper Fig. latency)."""
+
 from __future__ import annotations
 
 import argparse
@@ -12,16 +13,24 @@ DEFAULT_DELAYS_MS = [0, 20, 40, 60, 80, 100, 150, 200, 300]
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("path", type=Path, help="a recording with IMU and ground truth")
     parser.add_argument("--out", type=Path, required=True, help="output folder: latency_sweep.csv/.md/.png")
-    parser.add_argument("--delays-ms", type=float, nargs="+", default=DEFAULT_DELAYS_MS,
-                        help="delays added to the measured processing time")
+    parser.add_argument(
+        "--delays-ms",
+        type=float,
+        nargs="+",
+        default=DEFAULT_DELAYS_MS,
+        help="delays added to the measured processing time",
+    )
     parser.add_argument("--max-frames", type=int, default=None, help="stop each run after this many scans")
     parser.add_argument("--no-plot", action="store_true", help="no latency_sweep.png")
 
 
 def run(args: argparse.Namespace) -> int:
-    rows = latency_sweep(args.path, args.out, [d / 1e3 for d in args.delays_ms], max_frames=args.max_frames,
-                         plot=not args.no_plot)
+    rows = latency_sweep(
+        args.path, args.out, [d / 1e3 for d in args.delays_ms], max_frames=args.max_frames, plot=not args.no_plot
+    )
     for r in rows:
-        print(f"added {r['added_delay_ms']:6.0f} ms: APE {r['ape_m']:.3f} m, RPE {r['rpe_pct']:.3f} %, "
-              f"dropped {r['dropped']}")
+        print(
+            f"added {r['added_delay_ms']:6.0f} ms: APE {r['ape_m']:.3f} m, RPE {r['rpe_pct']:.3f} %, "
+            f"dropped {r['dropped']}"
+        )
     return 0

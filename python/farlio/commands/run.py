@@ -1,4 +1,5 @@
 """`farlio run`: odometry over a recording, with trajectories, timings and a summary in --out."""
+
 from __future__ import annotations
 
 import argparse
@@ -15,54 +16,114 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", type=Path, required=True, help="output folder (created)")
     parser.add_argument("--format", default="auto", choices=["auto", *FORMATS], help="input format")
     parser.add_argument("--config", type=Path, default=None, help="YAML file overriding config fields")
-    parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
-                        help="override one config field, e.g. --set map.voxel_size_m=2 (repeatable)")
+    parser.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="override one config field, e.g. --set map.voxel_size_m=2 (repeatable)",
+    )
     parser.add_argument("--threads", type=int, default=None, help="CPU threads (default: all; = num_threads)")
-    parser.add_argument("--device", choices=DEVICES, default=None,
-                        help="scan pipeline backend (= the config field device, default auto): auto takes the GPU "
-                             "when one is present and falls back to the CPU with a message; cuda without one is an error")
+    parser.add_argument(
+        "--device",
+        choices=DEVICES,
+        default=None,
+        help="scan pipeline backend (= the config field device, default auto): auto takes the GPU "
+        "when one is present and falls back to the CPU with a message; cuda without one is an error",
+    )
     parser.add_argument("--max-frames", type=int, default=None, help="stop after this many scans")
-    parser.add_argument("--gt", type=Path, default=None,
-                        help="ground-truth body poses (TUM) to evaluate against; a sequence folder's "
-                             "groundtruth_scans.tum (MulRan: global_pose.csv) is used by default")
+    parser.add_argument(
+        "--gt",
+        type=Path,
+        default=None,
+        help="ground-truth body poses (TUM) to evaluate against; a sequence folder's "
+        "groundtruth_scans.tum (MulRan: global_pose.csv) is used by default",
+    )
     rec = parser.add_argument_group("recordings (bags, Ouster, calibration)")
-    rec.add_argument("--lidar-topic", dest="lidar_topics", action="append", default=[], metavar="TOPIC",
-                     help="PointCloud2 topic of a bag (or Ouster lidar_packets topic); repeat it to merge several "
-                          "LiDARs into one scan per period of the first; not given: the bag's only PointCloud2 topic")
-    rec.add_argument("--imu-topic", default=None, metavar="TOPIC",
-                     help="sensor_msgs/Imu topic of a bag ('none': LiDAR-only); not given: the bag's only Imu topic")
-    rec.add_argument("--calib", type=Path, default=None, metavar="YAML",
-                     help="extrinsics file with T_imu_lidar (4x4, or {topic: 4x4} for several LiDARs); overrides "
-                          "/tf_static and the recording's own calibration")
-    rec.add_argument("--meta", type=Path, default=None, metavar="JSON",
-                     help="Ouster sensor metadata; not given: the .pcap's name with .json, or the bag's metadata topic")
-    rec.add_argument("--time-field", default="auto", metavar="NAME",
-                     help=f"PointCloud2 per-point time field ('auto': first of {', '.join(TIME_FIELDS)}; "
-                          f"'none': no per-point time, no undistortion)")
-    rec.add_argument("--time-unit", default="auto", choices=TIME_UNITS,
-                     help="unit of the time field ('auto': float fields in s, integer fields in ns)")
-    rec.add_argument("--header-stamp", default="auto", choices=HEADER_STAMPS,
-                     help="whether a cloud's header stamp is its scan start or end ('auto': end when all "
-                          "relative point times are <= 0, else start)")
+    rec.add_argument(
+        "--lidar-topic",
+        dest="lidar_topics",
+        action="append",
+        default=[],
+        metavar="TOPIC",
+        help="PointCloud2 topic of a bag (or Ouster lidar_packets topic); repeat it to merge several "
+        "LiDARs into one scan per period of the first; not given: the bag's only PointCloud2 topic",
+    )
+    rec.add_argument(
+        "--imu-topic",
+        default=None,
+        metavar="TOPIC",
+        help="sensor_msgs/Imu topic of a bag ('none': LiDAR-only); not given: the bag's only Imu topic",
+    )
+    rec.add_argument(
+        "--calib",
+        type=Path,
+        default=None,
+        metavar="YAML",
+        help="extrinsics file with T_imu_lidar (4x4, or {topic: 4x4} for several LiDARs); overrides "
+        "/tf_static and the recording's own calibration",
+    )
+    rec.add_argument(
+        "--meta",
+        type=Path,
+        default=None,
+        metavar="JSON",
+        help="Ouster sensor metadata; not given: the .pcap's name with .json, or the bag's metadata topic",
+    )
+    rec.add_argument(
+        "--time-field",
+        default="auto",
+        metavar="NAME",
+        help=f"PointCloud2 per-point time field ('auto': first of {', '.join(TIME_FIELDS)}; "
+        f"'none': no per-point time, no undistortion)",
+    )
+    rec.add_argument(
+        "--time-unit",
+        default="auto",
+        choices=TIME_UNITS,
+        help="unit of the time field ('auto': float fields in s, integer fields in ns)",
+    )
+    rec.add_argument(
+        "--header-stamp",
+        default="auto",
+        choices=HEADER_STAMPS,
+        help="whether a cloud's header stamp is its scan start or end ('auto': end when all "
+        "relative point times are <= 0, else start)",
+    )
     rec.add_argument("--no-imu", action="store_true", help="ignore the recording's IMU: LiDAR-only odometry")
-    parser.add_argument("--latency", default="measured", choices=["measured", "zero", "fixed"],
-                        help="replay latency model: a scan's result reaches the fusion after its measured "
-                             "processing time, at once, or after --fixed-latency")
+    parser.add_argument(
+        "--latency",
+        default="measured",
+        choices=["measured", "zero", "fixed"],
+        help="replay latency model: a scan's result reaches the fusion after its measured "
+        "processing time, at once, or after --fixed-latency",
+    )
     parser.add_argument("--fixed-latency", type=float, default=0.0, metavar="S", help="latency with --latency fixed")
-    parser.add_argument("--added-delay", type=float, default=0.0, metavar="S",
-                        help="extra delay added to every result (latency sweeps)")
-    parser.add_argument("--save-map", action="store_true", help="write the final submap (world frame) as map.ply and map.pcd")
-    parser.add_argument("--no-plot", action="store_true",
-                        help="do not write trajectory.png, latency.png and eval.png")
+    parser.add_argument(
+        "--added-delay", type=float, default=0.0, metavar="S", help="extra delay added to every result (latency sweeps)"
+    )
+    parser.add_argument(
+        "--save-map", action="store_true", help="write the final submap (world frame) as map.ply and map.pcd"
+    )
+    parser.add_argument("--no-plot", action="store_true", help="do not write trajectory.png, latency.png and eval.png")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
-    parser.add_argument("--view", action="store_true",
-                        help="live 3D view with rerun-sdk (pip install rerun-sdk); without a display the view is "
-                             "saved as run.rrd in --out")
+    parser.add_argument(
+        "--view",
+        action="store_true",
+        help="live 3D view with rerun-sdk (pip install rerun-sdk); without a display the view is "
+        "saved as run.rrd in --out",
+    )
 
 
 def load_options(args: argparse.Namespace) -> LoadOptions:
-    return LoadOptions(lidar_topics=list(args.lidar_topics), imu_topic=args.imu_topic, calib=args.calib,
-                       meta=args.meta, time=TimeOptions(args.time_field, args.time_unit, args.header_stamp))
+    return LoadOptions(
+        lidar_topics=list(args.lidar_topics),
+        imu_topic=args.imu_topic,
+        calib=args.calib,
+        meta=args.meta,
+        time=TimeOptions(args.time_field, args.time_unit, args.header_stamp),
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -75,14 +136,24 @@ def run(args: argparse.Namespace) -> int:
     viewer = None
     if args.view:
         from farlio.viewer import RerunViewer
+
         args.out.mkdir(parents=True, exist_ok=True)
         viewer = RerunViewer(args.out)
         print(f"live view: {viewer.where}")
     dataset = open_dataset(args.path, args.format, load_options(args))
-    summary = run_dataset(dataset, args.out, config, max_frames=args.max_frames, save_map=args.save_map,
-                          groundtruth=args.gt, progress=False if args.no_progress else None,
-                          plot=not args.no_plot, use_imu=not args.no_imu, on_frame=viewer,
-                          options=replay_options(args.latency, args.fixed_latency, args.added_delay))
+    summary = run_dataset(
+        dataset,
+        args.out,
+        config,
+        max_frames=args.max_frames,
+        save_map=args.save_map,
+        groundtruth=args.gt,
+        progress=False if args.no_progress else None,
+        plot=not args.no_plot,
+        use_imu=not args.no_imu,
+        on_frame=viewer,
+        options=replay_options(args.latency, args.fixed_latency, args.added_delay),
+    )
     print(format_summary(summary))
     print(f"outputs in {args.out}")
     return 0

@@ -1,4 +1,5 @@
 """`farlio simulate`: a LiDAR + IMU sequence with exact ground truth, in the sequence folder format."""
+
 from __future__ import annotations
 
 import argparse
@@ -11,29 +12,44 @@ PROFILES = ("racetrack", "urban", "handheld")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("profile", choices=PROFILES,
-                        help="racetrack: 3 LiDARs at 20 Hz, up to 70 m/s, 800 Hz IMU; urban: 64-beam LiDAR at "
-                             "10 Hz, 8-15 m/s, 100 Hz IMU; handheld: 32-beam LiDAR at 10 Hz, rooms and corridors, "
-                             "200 Hz IMU (docs/simulation.md)")
+    parser.add_argument(
+        "profile",
+        choices=PROFILES,
+        help="racetrack: 3 LiDARs at 20 Hz, up to 70 m/s, 800 Hz IMU; urban: 64-beam LiDAR at "
+        "10 Hz, 8-15 m/s, 100 Hz IMU; handheld: 32-beam LiDAR at 10 Hz, rooms and corridors, "
+        "200 Hz IMU (docs/simulation.md)",
+    )
     parser.add_argument("--out", type=Path, required=True, help="output sequence folder (created)")
     parser.add_argument("--seed", type=int, default=1, help="noise seed (the scene and trajectory are fixed)")
-    parser.add_argument("--duration", type=float, default=None,
-                        help="seconds to generate (default: the profile's, docs/simulation.md)")
+    parser.add_argument(
+        "--duration", type=float, default=None, help="seconds to generate (default: the profile's, docs/simulation.md)"
+    )
     parser.add_argument("--noise-free", action="store_true", help="exact ranges, no dropout, IMU without noise/bias")
     parser.add_argument("--range-noise", type=float, default=None, metavar="M", help="range noise std (m)")
     parser.add_argument("--dropout", type=float, default=None, metavar="P", help="chance a ray returns nothing")
     parser.add_argument("--gyro-noise", type=float, default=None, metavar="RAD_S", help="gyro white noise std")
     parser.add_argument("--accel-noise", type=float, default=None, metavar="M_S2", help="accel white noise std")
     parser.add_argument("--kitti", action="store_true", help="also write velodyne/*.bin + times.txt (KITTI layout)")
-    parser.add_argument("--encoding", default="binary", choices=["ascii", "binary", "binary_compressed"],
-                        help="PCD encoding of lidar/*.pcd")
+    parser.add_argument(
+        "--encoding",
+        default="binary",
+        choices=["ascii", "binary", "binary_compressed"],
+        help="PCD encoding of lidar/*.pcd",
+    )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 
 def run(args: argparse.Namespace) -> int:
-    cfg = make_config(args.profile, seed=args.seed, duration_s=args.duration, noise_free=args.noise_free,
-                      range_noise_std_m=args.range_noise, dropout_probability=args.dropout,
-                      gyro_noise_std_rad_s=args.gyro_noise, accel_noise_std_m_s2=args.accel_noise)
+    cfg = make_config(
+        args.profile,
+        seed=args.seed,
+        duration_s=args.duration,
+        noise_free=args.noise_free,
+        range_noise_std_m=args.range_noise,
+        dropout_probability=args.dropout,
+        gyro_noise_std_rad_s=args.gyro_noise,
+        accel_noise_std_m_s2=args.accel_noise,
+    )
     bar = Progress(0, f"simulate {args.profile}", False if args.no_progress else None)
 
     def on_scan(done: int, total: int) -> None:
@@ -42,6 +58,8 @@ def run(args: argparse.Namespace) -> int:
 
     stats = write_sequence(cfg, args.out, kitti=args.kitti, encoding=args.encoding, on_scan=on_scan)
     bar.close()
-    print(f"{args.profile}: {stats['scans']} scans of {stats['points_per_scan']:.0f} points on average, "
-          f"{1e3 * stats['generation_s_per_scan']:.1f} ms to generate a scan; written to {args.out}")
+    print(
+        f"{args.profile}: {stats['scans']} scans of {stats['points_per_scan']:.0f} points on average, "
+        f"{1e3 * stats['generation_s_per_scan']:.1f} ms to generate a scan; written to {args.out}"
+    )
     return 0

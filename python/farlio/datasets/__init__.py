@@ -3,6 +3,7 @@
 A dataset gives scans (farlio.Scan with stamps and per-point times), and where it has them the
 IMU samples, the LiDAR-IMU extrinsic and ground truth. See docs/datasets.md.
 """
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -25,10 +26,12 @@ FORMATS = {
     "rosbag": RosBag,
     "folder": PointCloudFolder,
 }
-FORMAT_HELP = ("sequence folder (lidar/), KITTI odometry (velodyne/ + times.txt), KITTI raw drive "
-               "(velodyne_points/ + oxts/), MulRan (sensor_data/Ouster/), Ouster .pcap (+ .json) or a bag of "
-               "Ouster packets, ROS 1 .bag or ROS 2 bag (folder with metadata.yaml, .db3, .mcap), "
-               "a folder of .pcd/.ply/.bin files")
+FORMAT_HELP = (
+    "sequence folder (lidar/), KITTI odometry (velodyne/ + times.txt), KITTI raw drive "
+    "(velodyne_points/ + oxts/), MulRan (sensor_data/Ouster/), Ouster .pcap (+ .json) or a bag of "
+    "Ouster packets, ROS 1 .bag or ROS 2 bag (folder with metadata.yaml, .db3, .mcap), "
+    "a folder of .pcd/.ply/.bin files"
+)
 
 
 def detect_format(path: Path) -> str:
@@ -39,8 +42,10 @@ def detect_format(path: Path) -> str:
     for name, cls in FORMATS.items():
         if cls.matches(path):
             return name
-    raise ValueError(f"{path}: cannot tell its format; expected one of: {FORMAT_HELP}; or pass --format with "
-                     f"one of: {', '.join(FORMATS)}")
+    raise ValueError(
+        f"{path}: cannot tell its format; expected one of: {FORMAT_HELP}; or pass --format with "
+        f"one of: {', '.join(FORMATS)}"
+    )
 
 
 def open_dataset(path: Path, fmt: str = "auto", options: LoadOptions | None = None) -> Dataset:

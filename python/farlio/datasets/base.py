@@ -1,4 +1,5 @@
 """The dataset interface every dataloader implements."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field

@@ -6,6 +6,7 @@ maps LiDAR points into the IMU/body frame; `gravity`), where for several LiDARs 
 be a mapping from topic (or frame id) to 4x4 matrix. It is read, and matrices are checked to be
 rigid, by the C++ reader (farlio._core.io, docs/io.md).
 """
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -33,9 +34,11 @@ def se3_from_quaternion(t: Any, q_xyzw: Any) -> farlio.SE3:
     n = np.sqrt(x * x + y * y + z * z + w * w)
     x, y, z, w = x / n, y / n, z / n, w / n
     m = np.eye(4)
-    m[:3, :3] = [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                 [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                 [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
+    m[:3, :3] = [
+        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+    ]
     m[:3, 3] = [float(v) for v in t]
     return farlio.SE3.from_matrix(m)
 

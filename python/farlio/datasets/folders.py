@@ -1,4 +1,5 @@
 """Dataloaders for folders: the sequence folder format, KITTI odometry, plain point cloud folders."""
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -120,4 +121,3 @@ class PointCloudFolder(_FilesWithStamps):
             self._stamps = [int(s) for s in stems]
         else:
             self._stamps = [(i + 1) * DEFAULT_PERIOD_NS for i in range(len(self._files))]
-

@@ -10,6 +10,7 @@ The OXTS poses (latitude, longitude, altitude, roll, pitch, yaw) become the grou
 body (OXTS) frame, as in the KITTI devkit: Mercator projection with the first latitude's scale,
 rotation Rz(yaw) Ry(pitch) Rx(roll), relative to the first pose (a TUM file in a temporary folder).
 """
+
 from __future__ import annotations
 
 import math
@@ -23,16 +24,16 @@ import farlio
 from farlio import _core
 from farlio._core import NS_PER_S
 
-from .base import Dataset, LoadOptions
+from .base import LoadOptions
 from .calib import CalibFile, se3_from_matrix
 from .folders import DEFAULT_PERIOD_NS, _FilesWithStamps
 
 CALIB_FILE = "calib_imu_to_velo.txt"
 #: columns of an OXTS line (KITTI devkit dataformat.txt)
-OXTS_ACCEL_COLUMNS = slice(11, 14)   # ax ay az
-OXTS_GYRO_COLUMNS = slice(17, 20)    # wx wy wz
+OXTS_ACCEL_COLUMNS = slice(11, 14)  # ax ay az
+OXTS_GYRO_COLUMNS = slice(17, 20)  # wx wy wz
 OXTS_COLUMNS = 30
-OXTS_POSE_COLUMNS = slice(0, 6)      # lat lon alt roll pitch yaw
+OXTS_POSE_COLUMNS = slice(0, 6)  # lat lon alt roll pitch yaw
 #: the Earth radius of the KITTI devkit's Mercator projection
 EARTH_RADIUS_M = 6378137.0
 
@@ -44,22 +45,35 @@ def parse_kitti_stamp(text: str, where: str) -> int:
         t = datetime.strptime(whole, "%Y-%m-%d %H:%M:%S").replace(tzinfo=timezone.utc)
         return int(t.timestamp()) * NS_PER_S + int((frac + "000000000")[:9])
     except ValueError:
-        raise ValueError(f"{where}: '{text.strip()}' is not a KITTI timestamp (YYYY-MM-DD HH:MM:SS.fffffffff)") \
-            from None
+        raise ValueError(
+            f"{where}: '{text.strip()}' is not a KITTI timestamp (YYYY-MM-DD HH:MM:SS.fffffffff)"
+        ) from None
 
 
 def read_stamps(path: Path) -> list[int]:
-    return [parse_kitti_stamp(line, f"{path}:{k + 1}") for k, line in enumerate(path.read_text().splitlines())
-            if line.strip()]
+    return [
+        parse_kitti_stamp(line, f"{path}:{k + 1}")
+        for k, line in enumerate(path.read_text().splitlines())
+        if line.strip()
+    ]
 
 
 def oxts_pose(lat_lon_alt_rpy: np.ndarray, scale: float) -> np.ndarray:
     """The OXTS frame's 4x4 pose in the local Mercator frame (KITTI devkit convertOxtsToPose)."""
     lat, lon, alt, roll, pitch, yaw = (float(v) for v in lat_lon_alt_rpy)
-    t = [scale * math.radians(lon) * EARTH_RADIUS_M,
-         scale * EARTH_RADIUS_M * math.log(math.tan(math.radians(90.0 + lat) / 2.0)), alt]
-    cr, sr, cp, sp, cy, sy = math.cos(roll), math.sin(roll), math.cos(pitch), math.sin(pitch), math.cos(yaw), \
-        math.sin(yaw)
+    t = [
+        scale * math.radians(lon) * EARTH_RADIUS_M,
+        scale * EARTH_RADIUS_M * math.log(math.tan(math.radians(90.0 + lat) / 2.0)),
+        alt,
+    ]
+    cr, sr, cp, sp, cy, sy = (
+        math.cos(roll),
+        math.sin(roll),
+        math.cos(pitch),
+        math.sin(pitch),
+        math.cos(yaw),
+        math.sin(yaw),
+    )
     rx = np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]])
     ry = np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])
     rz = np.array([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]])
@@ -119,8 +133,10 @@ class KittiRaw(_FilesWithStamps):
 
     def _checked(self, stamps: list[int], where: Path) -> list[int]:
         if len(stamps) != len(self._files):
-            raise ValueError(f"{where}: {len(stamps)} stamps for {len(self._files)} scans in "
-                             f"{self.path / 'velodyne_points' / 'data'}")
+            raise ValueError(
+                f"{where}: {len(stamps)} stamps for {len(self._files)} scans in "
+                f"{self.path / 'velodyne_points' / 'data'}"
+            )
         return stamps
 
     def _read_oxts(self) -> list[farlio.ImuSample]:
@@ -131,8 +147,9 @@ class KittiRaw(_FilesWithStamps):
         stamps = read_stamps(oxts / "timestamps.txt")
         files = sorted((oxts / "data").glob("*.txt"))
         if len(files) != len(stamps):
-            raise ValueError(f"{oxts / 'timestamps.txt'}: {len(stamps)} stamps for {len(files)} files in "
-                             f"{oxts / 'data'}")
+            raise ValueError(
+                f"{oxts / 'timestamps.txt'}: {len(stamps)} stamps for {len(files)} files in {oxts / 'data'}"
+            )
         samples = []
         self._oxts_stamps = stamps
         for stamp, f in zip(stamps, files):
@@ -155,8 +172,10 @@ class KittiRaw(_FilesWithStamps):
             if (folder / CALIB_FILE).exists():
                 return read_imu_to_velo(folder / CALIB_FILE).inverse()
         if self._imu:
-            self._warnings.append(f"{self.path}: no {CALIB_FILE} here or in the parent folder and no --calib: "
-                                  f"assuming the Velodyne and OXTS frames coincide")
+            self._warnings.append(
+                f"{self.path}: no {CALIB_FILE} here or in the parent folder and no --calib: "
+                f"assuming the Velodyne and OXTS frames coincide"
+            )
         return farlio.SE3()
 
     def scan(self, i: int) -> farlio.Scan:

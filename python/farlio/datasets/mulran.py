@@ -6,6 +6,7 @@ Scan end stamps are the file names. The ground truth (global_pose.csv) is writte
 into a cache folder beside nothing of the recording (the system's temporary folder). The Xsens
 IMU is used only with --calib (its extrinsic to the Ouster is not in the recording).
 """
+
 from __future__ import annotations
 
 import tempfile
@@ -16,7 +17,7 @@ import numpy as np
 import farlio
 from farlio import _core
 
-from .base import Dataset, LoadOptions
+from .base import LoadOptions
 from .calib import CalibFile
 from .folders import _FilesWithStamps
 
@@ -25,7 +26,7 @@ DATA_STAMP = Path("sensor_data") / "data_stamp.csv"
 XSENS_IMU = Path("sensor_data") / "xsens_imu.csv"
 GLOBAL_POSE = "global_pose.csv"
 OUSTER_SENSOR = "ouster"
-POSE_COLUMNS = 13            # stamp + 3x4
+POSE_COLUMNS = 13  # stamp + 3x4
 #: xsens_imu.csv: stamp, quaternion (4), euler (3), gyro (3), accel (3), magnetometer (3)
 XSENS_GYRO_COLUMNS = slice(8, 11)
 XSENS_ACCEL_COLUMNS = slice(11, 14)
@@ -69,8 +70,10 @@ class MulRan(_FilesWithStamps):
             listed = self._listed_stamps()
             missing = [s for s in listed if str(s) not in files]
             if missing:
-                self._warnings.append(f"{self.path / DATA_STAMP}: {len(missing)} Ouster stamps without a file in "
-                                      f"{OUSTER_DIR} (first {missing[0]}); those scans are left out")
+                self._warnings.append(
+                    f"{self.path / DATA_STAMP}: {len(missing)} Ouster stamps without a file in "
+                    f"{OUSTER_DIR} (first {missing[0]}); those scans are left out"
+                )
             stamps = [s for s in listed if str(s) in files]
         if not stamps:
             raise ValueError(f"{self.path / OUSTER_DIR}: no <stamp_ns>.bin scans")
@@ -95,12 +98,15 @@ class MulRan(_FilesWithStamps):
             return []
         if self._calib is None:
             if not any("xsens" in w for w in self._warnings):
-                self._warnings.append(f"{path} is not used without --calib (the Xsens-Ouster extrinsic): "
-                                      f"LiDAR-only odometry")
+                self._warnings.append(
+                    f"{path} is not used without --calib (the Xsens-Ouster extrinsic): LiDAR-only odometry"
+                )
             return []
         stamps, table = read_stamped_csv(path, XSENS_MIN_COLUMNS)
-        gyro, accel = table[:, XSENS_GYRO_COLUMNS.start - 1:XSENS_GYRO_COLUMNS.stop - 1], \
-            table[:, XSENS_ACCEL_COLUMNS.start - 1:XSENS_ACCEL_COLUMNS.stop - 1]
+        gyro, accel = (
+            table[:, XSENS_GYRO_COLUMNS.start - 1 : XSENS_GYRO_COLUMNS.stop - 1],
+            table[:, XSENS_ACCEL_COLUMNS.start - 1 : XSENS_ACCEL_COLUMNS.stop - 1],
+        )
         return [farlio.ImuSample(s, g, a) for s, g, a in zip(stamps, gyro, accel)]
 
     def T_imu_lidar(self) -> farlio.SE3:

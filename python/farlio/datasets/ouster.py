@@ -12,10 +12,12 @@ T_imu_lidar is the inverse of the metadata's imu_to_sensor_transform (mm convert
 The recording is passed twice: at opening (IMU samples and the number of complete frames) and
 then sequentially for the scans, so that a long capture is never held in memory.
 """
+
 from __future__ import annotations
 
+from collections.abc import Iterator
 from pathlib import Path
-from typing import Any, Iterator
+from typing import Any
 
 import numpy as np
 
@@ -38,8 +40,10 @@ def _sdk() -> Any:
     try:
         from ouster.sdk import core
     except ImportError:
-        raise ValueError("reading Ouster recordings needs the 'ouster-sdk' package: pip install ouster-sdk "
-                         "(or pip install 'farlio[ouster]')") from None
+        raise ValueError(
+            "reading Ouster recordings needs the 'ouster-sdk' package: pip install ouster-sdk "
+            "(or pip install 'farlio[ouster]')"
+        ) from None
     return core
 
 
@@ -94,9 +98,11 @@ class OusterRecording(Dataset):
             else:
                 self._count += 1
         if self._count == 0:
-            raise ValueError(f"{self.path}: no complete LiDAR frame in the recording "
-                             f"({self.info.format.columns_per_frame} columns x {self.info.format.pixels_per_column} "
-                             f"beams expected from the metadata)")
+            raise ValueError(
+                f"{self.path}: no complete LiDAR frame in the recording "
+                f"({self.info.format.columns_per_frame} columns x {self.info.format.pixels_per_column} "
+                f"beams expected from the metadata)"
+            )
         self._imu.sort(key=lambda s: s.stamp_ns)
         self._gen: Iterator[farlio.Scan] | None = None
         self._next = 0
@@ -115,8 +121,10 @@ class OusterRecording(Dataset):
             return prefixed[0]
         if len(jsons) == 1:
             return jsons[0]
-        raise ValueError(f"{self.path}: no sensor metadata: expected {same.name} or one .json beside it (found "
-                         f"{', '.join(j.name for j in jsons) or 'none'}); pass --meta FILE.json")
+        raise ValueError(
+            f"{self.path}: no sensor metadata: expected {same.name} or one .json beside it (found "
+            f"{', '.join(j.name for j in jsons) or 'none'}); pass --meta FILE.json"
+        )
 
     def _parse_meta(self, text: str, where: str) -> Any:
         try:
@@ -131,24 +139,30 @@ class OusterRecording(Dataset):
         if self.options.lidar_topics:
             wanted = self.options.lidar_topics
             if len(wanted) > 1 or wanted[0] not in lidar:
-                raise ValueError(f"{self.path}: --lidar-topic {' '.join(wanted)}: expected one Ouster lidar_packets "
-                                 f"topic of: {', '.join(lidar)} (merging several Ouster sensors from packets is not "
-                                 f"supported; convert to PointCloud2)")
+                raise ValueError(
+                    f"{self.path}: --lidar-topic {' '.join(wanted)}: expected one Ouster lidar_packets "
+                    f"topic of: {', '.join(lidar)} (merging several Ouster sensors from packets is not "
+                    f"supported; convert to PointCloud2)"
+                )
             lidar = list(wanted)
         if len(lidar) != 1:
-            raise ValueError(f"{self.path}: {len(lidar)} Ouster lidar_packets topics ({', '.join(lidar)}): pass "
-                             f"--lidar-topic")
+            raise ValueError(
+                f"{self.path}: {len(lidar)} Ouster lidar_packets topics ({', '.join(lidar)}): pass --lidar-topic"
+            )
         ns = lidar[0][: -len(LIDAR_TOPIC_PART)]
         self.lidar_topic = lidar[0]
         imu = [t for t in topics[IMU_TOPIC_PART] if t.startswith(ns)]
-        self.imu_topic = None if self.options.imu_topic == "none" else (
-            self.options.imu_topic or (imu[0] if imu else None))
+        self.imu_topic = (
+            None if self.options.imu_topic == "none" else (self.options.imu_topic or (imu[0] if imu else None))
+        )
         meta = [t for t in topics[METADATA_TOPIC_PART] if t.startswith(ns)]
         if self.options.meta is not None:
             self.info = self._parse_meta(Path(self.options.meta).read_text(), str(self.options.meta))
         elif not meta:
-            raise ValueError(f"{self.path}: no Ouster metadata topic ({ns}{METADATA_TOPIC_PART}, {METADATA_TYPE}) "
-                             f"beside {self.lidar_topic}; topics: {describe_topics(self._reader)}; pass --meta FILE.json")
+            raise ValueError(
+                f"{self.path}: no Ouster metadata topic ({ns}{METADATA_TOPIC_PART}, {METADATA_TYPE}) "
+                f"beside {self.lidar_topic}; topics: {describe_topics(self._reader)}; pass --meta FILE.json"
+            )
         else:
             conns = [c for c in self._reader.connections if c.topic == meta[0]]
             msg = next((m for _, _, m in bag_messages(self._reader, self.path, conns)), None)
@@ -158,6 +172,7 @@ class OusterRecording(Dataset):
 
     def _osf_source(self) -> Any:
         from ouster.sdk.osf import OsfFrameSetSource
+
         try:
             return OsfFrameSetSource(str(self.path))
         except Exception as e:  # the SDK raises RuntimeError on a bad file
@@ -167,6 +182,7 @@ class OusterRecording(Dataset):
         core = self._core
         if self.path.suffix == PCAP_SUFFIX:
             from ouster.sdk.pcap import PcapPacketSource
+
             try:
                 source = PcapPacketSource(str(self.path), meta=[str(self.meta_path)])
             except Exception as e:
@@ -180,8 +196,10 @@ class OusterRecording(Dataset):
             packet = topics[conn.topic](self._pf)
             size = len(packet.buf)
             if len(msg.buf) < size:
-                raise ValueError(f"{self.path}: topic {conn.topic}: packet at {t} ns has {len(msg.buf)} bytes; the "
-                                 f"metadata's format needs {size}")
+                raise ValueError(
+                    f"{self.path}: topic {conn.topic}: packet at {t} ns has {len(msg.buf)} bytes; the "
+                    f"metadata's format needs {size}"
+                )
             packet.buf[:] = msg.buf[:size]
             packet.host_timestamp = t
             yield packet
@@ -203,8 +221,9 @@ class OusterRecording(Dataset):
             if isinstance(packet, core.ImuPacket):
                 stamps, acc, gyro = packet.timestamp(), packet.accel(), packet.gyro()
                 for k in range(len(stamps)):
-                    yield farlio.ImuSample(int(stamps[k]), np.asarray(gyro[k], np.float64),
-                                           np.asarray(acc[k], np.float64))
+                    yield farlio.ImuSample(
+                        int(stamps[k]), np.asarray(gyro[k], np.float64), np.asarray(acc[k], np.float64)
+                    )
             elif isinstance(packet, core.LidarPacket) and batcher.batch(packet, frame):
                 yield frame
                 frame = core.LidarFrame(self.info)
@@ -223,8 +242,9 @@ class OusterRecording(Dataset):
         intensity = None
         if frame.has_field(core.ChanField.REFLECTIVITY):
             intensity = np.asarray(frame.field(core.ChanField.REFLECTIVITY))[keep].astype(np.float32)
-        return farlio.Scan(np.ascontiguousarray(xyz), time_s=t, intensity=intensity, start_stamp_ns=start,
-                           end_stamp_ns=end)
+        return farlio.Scan(
+            np.ascontiguousarray(xyz), time_s=t, intensity=intensity, start_stamp_ns=start, end_stamp_ns=end
+        )
 
     # --- Dataset ---------------------------------------------------------------------------------------
     def __len__(self) -> int:

@@ -19,10 +19,12 @@ ABSOLUTE_TIME_MIN_S seconds are absolute times, others are offsets from the head
 Offsets that are all <= 0 mean that the header stamp is the scan END (Velodyne's newer drivers).
 A time span longer than MAX_SCAN_SPAN_S is rejected as an unknown unit, naming the field.
 """
+
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -62,8 +64,9 @@ class TimeOptions:
         if self.unit not in TIME_UNITS:
             raise ValueError(f"unknown time unit '{self.unit}'; expected one of {', '.join(TIME_UNITS)}")
         if self.header_stamp not in HEADER_STAMPS:
-            raise ValueError(f"unknown header stamp meaning '{self.header_stamp}'; expected one of "
-                             f"{', '.join(HEADER_STAMPS)}")
+            raise ValueError(
+                f"unknown header stamp meaning '{self.header_stamp}'; expected one of {', '.join(HEADER_STAMPS)}"
+            )
 
 
 @dataclass
@@ -101,13 +104,17 @@ def cloud_dtype(msg: Any, where: str) -> np.dtype:
     names, formats, offsets = [], [], []
     for f in msg.fields:
         if f.datatype not in POINTFIELD_TYPES:
-            raise CloudError(f"{where}: field '{f.name}' has datatype {f.datatype}; expected one of "
-                             f"{sorted(POINTFIELD_TYPES)} (sensor_msgs/PointField)")
+            raise CloudError(
+                f"{where}: field '{f.name}' has datatype {f.datatype}; expected one of "
+                f"{sorted(POINTFIELD_TYPES)} (sensor_msgs/PointField)"
+            )
         base = np.dtype(order + POINTFIELD_TYPES[f.datatype])
         count = max(int(f.count), 1)
         if f.offset + base.itemsize * count > msg.point_step:
-            raise CloudError(f"{where}: field '{f.name}' at offset {f.offset} ({count} x {base.itemsize} bytes) "
-                             f"extends past point_step {msg.point_step}")
+            raise CloudError(
+                f"{where}: field '{f.name}' at offset {f.offset} ({count} x {base.itemsize} bytes) "
+                f"extends past point_step {msg.point_step}"
+            )
         if f.name in names:  # duplicate names (some drivers): keep the first
             continue
         names.append(f.name)
@@ -120,16 +127,21 @@ def structured_points(msg: Any, where: str) -> np.ndarray:
     """The message's points as a 1-D structured array (rows with padding at their ends handled)."""
     dtype = cloud_dtype(msg, where)
     n = int(msg.width) * int(msg.height)
-    data = np.ascontiguousarray(msg.data).view(np.uint8).reshape(-1) if isinstance(msg.data, np.ndarray) \
+    data = (
+        np.ascontiguousarray(msg.data).view(np.uint8).reshape(-1)
+        if isinstance(msg.data, np.ndarray)
         else np.frombuffer(msg.data, dtype=np.uint8)
+    )
     row_bytes = int(msg.width) * int(msg.point_step)
     row_step = int(msg.row_step) or row_bytes
     needed = (int(msg.height) - 1) * row_step + row_bytes if n else 0
     if data.size < needed:
-        raise CloudError(f"{where}: data holds {data.size} bytes but {msg.height} rows of {msg.width} points "
-                         f"need {needed} (row_step {row_step}, point_step {msg.point_step}; truncated?)")
+        raise CloudError(
+            f"{where}: data holds {data.size} bytes but {msg.height} rows of {msg.width} points "
+            f"need {needed} (row_step {row_step}, point_step {msg.point_step}; truncated?)"
+        )
     if row_step == row_bytes or msg.height <= 1:
-        return np.frombuffer(data[:n * msg.point_step], dtype=dtype)
+        return np.frombuffer(data[: n * msg.point_step], dtype=dtype)
     rows = np.lib.stride_tricks.as_strided(data, shape=(msg.height, row_bytes), strides=(row_step, 1))
     return np.frombuffer(np.ascontiguousarray(rows), dtype=dtype)
 
@@ -164,10 +176,12 @@ def _offsets_s(values: np.ndarray, header_ns: int, name: str, options: TimeOptio
         offsets = values.astype(np.float64) * scale
     span = (hi - lo) * scale
     if not np.isfinite(span) or span > MAX_SCAN_SPAN_S:
-        raise CloudError(f"{where}: time field '{name}' ({values.dtype}) spans {hi - lo:g} raw units, which in "
-                         f"{unit} is {span:g} s, longer than a scan can last ({MAX_SCAN_SPAN_S:g} s): unknown time "
-                         f"unit; pass the unit explicitly (--time-unit one of {', '.join(NS_PER_UNIT)}) or "
-                         f"--time-field none")
+        raise CloudError(
+            f"{where}: time field '{name}' ({values.dtype}) spans {hi - lo:g} raw units, which in "
+            f"{unit} is {span:g} s, longer than a scan can last ({MAX_SCAN_SPAN_S:g} s): unknown time "
+            f"unit; pass the unit explicitly (--time-unit one of {', '.join(NS_PER_UNIT)}) or "
+            f"--time-field none"
+        )
     return offsets
 
 
@@ -178,8 +192,10 @@ def decode(msg: Any, where: str, options: TimeOptions | None = None) -> Cloud:
     names = field_names(msg)
     missing = [c for c in "xyz" if c not in names]
     if missing:
-        raise CloudError(f"{where}: PointCloud2 has no field {', '.join(repr(m) for m in missing)} "
-                         f"(fields: {', '.join(names) or 'none'}); expected x, y, z")
+        raise CloudError(
+            f"{where}: PointCloud2 has no field {', '.join(repr(m) for m in missing)} "
+            f"(fields: {', '.join(names) or 'none'}); expected x, y, z"
+        )
     pts = structured_points(msg, where)
     xyz = np.empty((len(pts), 3), dtype=np.float32)
     for k, c in enumerate("xyz"):

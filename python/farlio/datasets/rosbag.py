@@ -11,11 +11,13 @@ Extrinsics: `--calib` file first, else /tf_static (the chain from the IMU messag
 cloud's frame), else identity with a warning. Scans are read in one sequential pass (a backward
 access restarts it); IMU and /tf_static are read when the bag is opened.
 """
+
 from __future__ import annotations
 
 from collections import deque
+from collections.abc import Iterator
 from pathlib import Path
-from typing import Any, Iterator
+from typing import Any
 
 import numpy as np
 
@@ -24,8 +26,7 @@ from farlio._core import NS_PER_S
 
 from .base import Dataset, LoadOptions
 from .calib import CalibFile, se3_from_quaternion
-from .pointcloud2 import (MAX_SCAN_SPAN_S, TIME_FIELDS, Cloud, CloudError, decode, field_names, stamp_ns,
-                          time_field_of)
+from .pointcloud2 import MAX_SCAN_SPAN_S, TIME_FIELDS, Cloud, CloudError, decode, field_names, stamp_ns, time_field_of
 
 POINTCLOUD2 = "sensor_msgs/msg/PointCloud2"
 IMU = "sensor_msgs/msg/Imu"
@@ -58,14 +59,16 @@ def open_bag(path: Path) -> Any:
         from rosbags.highlevel import AnyReader
         from rosbags.typesys import Stores, get_typestore
     except ImportError:
-        raise ValueError(f"{path}: reading ROS bags needs the 'rosbags' package: pip install rosbags "
-                         f"(or pip install 'farlio[ros]')") from None
+        raise ValueError(
+            f"{path}: reading ROS bags needs the 'rosbags' package: pip install rosbags (or pip install 'farlio[ros]')"
+        ) from None
     try:
         reader = AnyReader([Path(path)], default_typestore=get_typestore(Stores.ROS2_HUMBLE))
         reader.open()
     except Exception as e:  # rosbags raises many types for corrupt or truncated files
-        raise ValueError(f"{path}: cannot open as a ROS bag ({type(e).__name__}: {e}); a truncated or corrupt "
-                         f"bag, or not a bag") from None
+        raise ValueError(
+            f"{path}: cannot open as a ROS bag ({type(e).__name__}: {e}); a truncated or corrupt bag, or not a bag"
+        ) from None
     return reader
 
 
@@ -73,8 +76,10 @@ def describe_topics(reader: Any) -> str:
     seen: dict[str, list[Any]] = {}
     for c in reader.connections:
         seen.setdefault(c.topic, []).append(c)
-    return ", ".join(f"{t} ({cs[0].msgtype}, {sum(c.msgcount for c in cs)} msgs)" for t, cs in sorted(seen.items())) \
+    return (
+        ", ".join(f"{t} ({cs[0].msgtype}, {sum(c.msgcount for c in cs)} msgs)" for t, cs in sorted(seen.items()))
         or "none"
+    )
 
 
 def bag_messages(reader: Any, path: Path, connections: list[Any]) -> Iterator[tuple[Any, int, Any]]:
@@ -92,8 +97,10 @@ def bag_messages(reader: Any, path: Path, connections: list[Any]) -> Iterator[tu
         try:
             msg = reader.deserialize(raw, conn.msgtype)
         except Exception as e:
-            raise BagError(f"{path}: topic {conn.topic}: cannot deserialise a {conn.msgtype} message at {t} ns "
-                           f"({type(e).__name__}: {e})") from None
+            raise BagError(
+                f"{path}: topic {conn.topic}: cannot deserialise a {conn.msgtype} message at {t} ns "
+                f"({type(e).__name__}: {e})"
+            ) from None
         yield conn, t, msg
 
 
@@ -143,9 +150,11 @@ class RosBag(Dataset):
         for topic, msg in zip(self.lidar_topics, firsts):
             decode(msg, f"{self.path} topic {topic} first message", self.options.time)  # bad fields fail here
             if time_field_of(msg, self.options.time) is None:
-                self._warnings.append(f"{self.path}: topic {topic} has no per-point time field (fields: "
-                                      f"{', '.join(field_names(msg))}; looked for {', '.join(TIME_FIELDS)}): "
-                                      f"its scans are not undistorted")
+                self._warnings.append(
+                    f"{self.path}: topic {topic} has no per-point time field (fields: "
+                    f"{', '.join(field_names(msg))}; looked for {', '.join(TIME_FIELDS)}): "
+                    f"its scans are not undistorted"
+                )
         self._has_time = all(time_field_of(m, self.options.time) is not None for m in firsts)
         self.imu_frame = ""
         self._imu = self._read_imu()
@@ -159,9 +168,11 @@ class RosBag(Dataset):
 
     def _check_topic(self, topic: str, msgtype: str, option: str) -> None:
         if topic not in self._by_topic:
-            raise ValueError(f"{self.path}: no topic '{topic}' ({option}); {msgtype} topics: "
-                             f"{', '.join(self._topics_of(msgtype)) or 'none'}; all topics: "
-                             f"{describe_topics(self._reader)}")
+            raise ValueError(
+                f"{self.path}: no topic '{topic}' ({option}); {msgtype} topics: "
+                f"{', '.join(self._topics_of(msgtype)) or 'none'}; all topics: "
+                f"{describe_topics(self._reader)}"
+            )
         found = self._by_topic[topic][0].msgtype
         if found != msgtype:
             raise ValueError(f"{self.path}: topic '{topic}' ({option}) is {found}; expected {msgtype}")
@@ -179,8 +190,10 @@ class RosBag(Dataset):
             return found
         if not found:
             raise ValueError(f"{self.path}: no {POINTCLOUD2} topic; topics: {describe_topics(self._reader)}")
-        raise ValueError(f"{self.path}: {len(found)} {POINTCLOUD2} topics ({', '.join(found)}): pass --lidar-topic "
-                         f"(repeat it to merge several LiDARs)")
+        raise ValueError(
+            f"{self.path}: {len(found)} {POINTCLOUD2} topics ({', '.join(found)}): pass --lidar-topic "
+            f"(repeat it to merge several LiDARs)"
+        )
 
     def _choose_imu_topic(self) -> str | None:
         topic = self.options.imu_topic
@@ -195,8 +208,10 @@ class RosBag(Dataset):
         if not found:
             self._warnings.append(f"{self.path}: no {IMU} topic: LiDAR-only odometry")
             return None
-        raise ValueError(f"{self.path}: {len(found)} {IMU} topics ({', '.join(found)}): pass --imu-topic "
-                         f"(or --imu-topic none for LiDAR-only)")
+        raise ValueError(
+            f"{self.path}: {len(found)} {IMU} topics ({', '.join(found)}): pass --imu-topic "
+            f"(or --imu-topic none for LiDAR-only)"
+        )
 
     def _first_cloud(self, topic: str) -> Any:
         for _, _, msg in bag_messages(self._reader, self.path, self._by_topic[topic]):
@@ -231,8 +246,13 @@ class RosBag(Dataset):
         for _, _, msg in bag_messages(self._reader, self.path, self._by_topic.get(TF_STATIC_TOPIC, [])):
             for tr in msg.transforms:
                 t, q = tr.transform.translation, tr.transform.rotation
-                edges.append((_frame(tr.header.frame_id), _frame(tr.child_frame_id),
-                              se3_from_quaternion((t.x, t.y, t.z), (q.x, q.y, q.z, q.w))))
+                edges.append(
+                    (
+                        _frame(tr.header.frame_id),
+                        _frame(tr.child_frame_id),
+                        se3_from_quaternion((t.x, t.y, t.z), (q.x, q.y, q.z, q.w)),
+                    )
+                )
         body = self.imu_frame if self.imu_topic is not None else self.frames[0]
         out = []
         for topic, frame in zip(self.lidar_topics, self.frames):
@@ -240,7 +260,8 @@ class RosBag(Dataset):
             if T is None:
                 self._warnings.append(
                     f"{self.path}: no extrinsic from LiDAR frame '{frame}' ({topic}) to the IMU frame '{body}' in "
-                    f"{TF_STATIC_TOPIC} ({len(edges)} transforms) and no --calib: assuming identity")
+                    f"{TF_STATIC_TOPIC} ({len(edges)} transforms) and no --calib: assuming identity"
+                )
                 T = farlio.SE3()
             out.append(T)
         return out
@@ -268,8 +289,9 @@ class RosBag(Dataset):
         while self._next <= i:
             item = next(self._gen, None)
             if item is None:
-                raise ValueError(f"{self.path}: topic {self.lidar_topics[0]} ended after {self._next} messages "
-                                 f"(scan {i} asked)")
+                raise ValueError(
+                    f"{self.path}: topic {self.lidar_topics[0]} ended after {self._next} messages (scan {i} asked)"
+                )
             self._next += 1
         if isinstance(item, Exception):
             raise item
@@ -281,8 +303,10 @@ class RosBag(Dataset):
         conns = [c for t in self.lidar_topics for c in self._by_topic[t]]
         for conn, t, msg in bag_messages(self._reader, self.path, conns):
             try:
-                yield index[conn.topic], decode(msg, f"{self.path} topic {conn.topic} message at {t} ns",
-                                                self.options.time)
+                yield (
+                    index[conn.topic],
+                    decode(msg, f"{self.path} topic {conn.topic} message at {t} ns", self.options.time),
+                )
             except CloudError as e:
                 yield index[conn.topic], e
 
@@ -322,26 +346,36 @@ class RosBag(Dataset):
     @staticmethod
     def _interval(cur: Cloud, nxt: Cloud | None, prev: tuple[int, int] | None) -> tuple[int, int]:
         """Scan start and end: the header stamp is one of them, the neighbouring header the other."""
+
         def plausible(d: int) -> bool:
             return 0 < d <= MAX_SCAN_SPAN_NS
+
         prev_period = prev[1] - prev[0] if prev else None
-        next_period = nxt.stamp_ns - cur.stamp_ns if nxt is not None and plausible(nxt.stamp_ns - cur.stamp_ns) \
-            else None
+        next_period = (
+            nxt.stamp_ns - cur.stamp_ns if nxt is not None and plausible(nxt.stamp_ns - cur.stamp_ns) else None
+        )
         offsets = cur.offset_s
         if cur.header_is_end:
             end = cur.stamp_ns
             if prev is not None and plausible(end - prev[1]):
                 return prev[1], end
-            period = next_period or prev_period or (
-                int(round(-offsets.min() * NS_PER_S)) if offsets is not None and offsets.size else DEFAULT_PERIOD_NS)
+            period = (
+                next_period
+                or prev_period
+                or (
+                    int(round(-offsets.min() * NS_PER_S)) if offsets is not None and offsets.size else DEFAULT_PERIOD_NS
+                )
+            )
             return end - period, end
         start = cur.stamp_ns
-        period = next_period or prev_period or (
-            int(round(offsets.max() * NS_PER_S)) if offsets is not None and offsets.size else DEFAULT_PERIOD_NS)
+        period = (
+            next_period
+            or prev_period
+            or (int(round(offsets.max() * NS_PER_S)) if offsets is not None and offsets.size else DEFAULT_PERIOD_NS)
+        )
         return start, start + max(period, 1)
 
-    def _assemble(self, cur: Cloud, start: int, end: int,
-                  others: list[deque[tuple[Cloud, np.ndarray]]]) -> farlio.Scan:
+    def _assemble(self, cur: Cloud, start: int, end: int, others: list[deque[tuple[Cloud, np.ndarray]]]) -> farlio.Scan:
         shift_s = (cur.stamp_ns - start) / NS_PER_S
         pts = [cur.points]
         times = [None if cur.offset_s is None else cur.offset_s + shift_s]
@@ -354,17 +388,25 @@ class RosBag(Dataset):
                 sel = (abs_ns >= start) & (abs_ns < end)
                 if not sel.any():
                     continue
-                pts.append((cloud.points[sel] @ m[:3, :3].T.astype(np.float32) + m[:3, 3].astype(np.float32)))
+                pts.append(cloud.points[sel] @ m[:3, :3].T.astype(np.float32) + m[:3, 3].astype(np.float32))
                 times.append((abs_ns[sel] - start) / NS_PER_S)
-                inten.append(cloud.intensity[sel] if cloud.intensity is not None
-                             else np.zeros(int(sel.sum()), np.float32))
+                inten.append(
+                    cloud.intensity[sel] if cloud.intensity is not None else np.zeros(int(sel.sum()), np.float32)
+                )
                 ids.append(np.full(int(sel.sum()), k, np.uint8))
             while q and q[0][1].max(initial=0) < end:
                 q.popleft()
+
         def joined(parts: list[np.ndarray]) -> np.ndarray:
             return parts[0] if len(parts) == 1 else np.concatenate(parts)
+
         points = np.ascontiguousarray(joined(pts), dtype=np.float32)
         time_s = joined(times).astype(np.float32) if self._has_time and all(t is not None for t in times) else None
-        return farlio.Scan(points, time_s=time_s, intensity=np.ascontiguousarray(joined(inten), dtype=np.float32),
-                           start_stamp_ns=start, end_stamp_ns=end,
-                           sensor_id=np.concatenate(ids) if len(self.lidar_topics) > 1 else None)
+        return farlio.Scan(
+            points,
+            time_s=time_s,
+            intensity=np.ascontiguousarray(joined(inten), dtype=np.float32),
+            start_stamp_ns=start,
+            end_stamp_ns=end,
+            sensor_id=np.concatenate(ids) if len(self.lidar_topics) > 1 else None,
+        )

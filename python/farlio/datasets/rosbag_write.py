@@ -3,6 +3,7 @@ with the per-point time convention of a chosen driver, sensor_msgs/Imu and /tf_s
 tests and benchmarks to produce bags whose content is known exactly; `write_dataset` converts any
 farlio dataset (e.g. a sequence folder) into a bag.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -12,7 +13,6 @@ from typing import Any
 import numpy as np
 
 import farlio
-
 from farlio._core import NS_PER_S
 
 STORAGES = ("ros1", "sqlite3", "mcap")
@@ -61,15 +61,17 @@ class BagWriter:
             self.ts.register(get_types_from_msg(TFMESSAGE_DEFINITION, TFMESSAGE))
         if self.ros1:
             from rosbags.rosbag1 import Writer
+
             self._writer = Writer(self.path)
         else:
             from rosbags.rosbag2 import StoragePlugin, Writer
+
             plugin = StoragePlugin.MCAP if storage == "mcap" else StoragePlugin.SQLITE3
             self._writer = Writer(self.path, version=ROS2_BAG_VERSION, storage_plugin=plugin)
         self._conns: dict[str, Any] = {}
         self._seq = 0
 
-    def __enter__(self) -> "BagWriter":
+    def __enter__(self) -> BagWriter:
         self._writer.open()
         return self
 
@@ -91,9 +93,18 @@ class BagWriter:
         data = self.ts.serialize_ros1(msg, msgtype) if self.ros1 else self.ts.serialize_cdr(msg, msgtype)
         self._writer.write(self._conns[topic], stamp, data)
 
-    def cloud(self, topic: str, frame: str, start_ns: int, end_ns: int, points: np.ndarray,
-              time_s: np.ndarray | None, intensity: np.ndarray | None, convention: str = "ouster",
-              padding: int = 0) -> None:
+    def cloud(
+        self,
+        topic: str,
+        frame: str,
+        start_ns: int,
+        end_ns: int,
+        points: np.ndarray,
+        time_s: np.ndarray | None,
+        intensity: np.ndarray | None,
+        convention: str = "ouster",
+        padding: int = 0,
+    ) -> None:
         """One PointCloud2; time_s: per-point time in s since start_ns. `padding` bytes are left
         unnamed at the end of every point (as drivers do for alignment)."""
         conv = CONVENTIONS[convention]
@@ -107,8 +118,14 @@ class BagWriter:
         for _, t in names:
             offsets.append(off)
             off += np.dtype(t).itemsize
-        dtype = np.dtype({"names": [n for n, _ in names], "formats": [t for _, t in names], "offsets": offsets,
-                          "itemsize": off + padding})
+        dtype = np.dtype(
+            {
+                "names": [n for n, _ in names],
+                "formats": [t for _, t in names],
+                "offsets": offsets,
+                "itemsize": off + padding,
+            }
+        )
         arr = np.zeros(len(points), dtype=dtype)
         for k, c in enumerate("xyz"):
             arr[c] = points[:, k]
@@ -122,13 +139,21 @@ class BagWriter:
                 rel_ns = np.round(t * NS_PER_S) + (start_ns - header_ns)
                 arr[conv.field] = rel_ns / conv.ns_per_unit if conv.ns_per_unit > 1 else np.round(rel_ns)
         field_type = self._type("sensor_msgs/msg/PointField")
-        fields = [field_type(name=n, offset=o, datatype=_POINTFIELD_CODES[t], count=1)
-                  for (n, t), o in zip(names, offsets)]
+        fields = [
+            field_type(name=n, offset=o, datatype=_POINTFIELD_CODES[t], count=1) for (n, t), o in zip(names, offsets)
+        ]
         msgtype = "sensor_msgs/msg/PointCloud2"
-        msg = self._type(msgtype)(header=self._header(header_ns, frame), height=1, width=len(points),
-                                  fields=fields, is_bigendian=False, point_step=dtype.itemsize,
-                                  row_step=dtype.itemsize * len(points), data=arr.view(np.uint8).reshape(-1),
-                                  is_dense=True)
+        msg = self._type(msgtype)(
+            header=self._header(header_ns, frame),
+            height=1,
+            width=len(points),
+            fields=fields,
+            is_bigendian=False,
+            point_step=dtype.itemsize,
+            row_step=dtype.itemsize * len(points),
+            data=arr.view(np.uint8).reshape(-1),
+            is_dense=True,
+        )
         self._write(topic, msgtype, end_ns, msg)
 
     def imu(self, topic: str, frame: str, samples: list[farlio.ImuSample]) -> None:
@@ -138,11 +163,15 @@ class BagWriter:
         cov = np.zeros(9)
         for s in samples:
             g, a = s.gyro_rad_s, s.accel_m_s2
-            msg = self._type(msgtype)(header=self._header(s.stamp_ns, frame), orientation=q,
-                                      orientation_covariance=cov, angular_velocity=v3(x=g[0], y=g[1], z=g[2]),
-                                      angular_velocity_covariance=cov,
-                                      linear_acceleration=v3(x=a[0], y=a[1], z=a[2]),
-                                      linear_acceleration_covariance=cov)
+            msg = self._type(msgtype)(
+                header=self._header(s.stamp_ns, frame),
+                orientation=q,
+                orientation_covariance=cov,
+                angular_velocity=v3(x=g[0], y=g[1], z=g[2]),
+                angular_velocity_covariance=cov,
+                linear_acceleration=v3(x=a[0], y=a[1], z=a[2]),
+                linear_acceleration_covariance=cov,
+            )
             self._write(topic, msgtype, s.stamp_ns, msg)
 
     def tf_static(self, stamp_ns: int, transforms: list[tuple[str, str, farlio.SE3]]) -> None:
@@ -152,15 +181,31 @@ class BagWriter:
         items = []
         for parent, child, T in transforms:
             t, qv = T.translation, T.quaternion_xyzw
-            items.append(stamped(header=self._header(stamp_ns, parent), child_frame_id=child,
-                                 transform=tr(translation=v3(x=t[0], y=t[1], z=t[2]),
-                                              rotation=quat(x=qv[0], y=qv[1], z=qv[2], w=qv[3]))))
+            items.append(
+                stamped(
+                    header=self._header(stamp_ns, parent),
+                    child_frame_id=child,
+                    transform=tr(
+                        translation=v3(x=t[0], y=t[1], z=t[2]), rotation=quat(x=qv[0], y=qv[1], z=qv[2], w=qv[3])
+                    ),
+                )
+            )
         self._write("/tf_static", TFMESSAGE, stamp_ns, self._type(TFMESSAGE)(transforms=items))
 
 
-def write_dataset(dataset: Any, path: Path, storage: str = "ros1", convention: str = "ouster", *,
-                  lidar_topic: str = "/points", imu_topic: str = "/imu", lidar_frame: str = "lidar",
-                  imu_frame: str = "imu", max_scans: int | None = None, padding: int = 0) -> Path:
+def write_dataset(
+    dataset: Any,
+    path: Path,
+    storage: str = "ros1",
+    convention: str = "ouster",
+    *,
+    lidar_topic: str = "/points",
+    imu_topic: str = "/imu",
+    lidar_frame: str = "lidar",
+    imu_frame: str = "imu",
+    max_scans: int | None = None,
+    padding: int = 0,
+) -> Path:
     """Writes a farlio dataset (scans, IMU, T_imu_lidar on /tf_static) as a bag."""
     n = len(dataset) if max_scans is None else min(max_scans, len(dataset))
     imu = dataset.imu()
@@ -173,6 +218,15 @@ def write_dataset(dataset: Any, path: Path, storage: str = "ros1", convention: s
             s = first if i == 0 else dataset.scan(i)
             time_s = np.asarray(s.time_s) if len(s.time_s) else None
             inten = np.asarray(s.intensity) if len(s.intensity) else None
-            w.cloud(lidar_topic, lidar_frame, s.start_stamp_ns, s.end_stamp_ns, np.asarray(s.points), time_s, inten,
-                    convention, padding)
+            w.cloud(
+                lidar_topic,
+                lidar_frame,
+                s.start_stamp_ns,
+                s.end_stamp_ns,
+                np.asarray(s.points),
+                time_s,
+                inten,
+                convention,
+                padding,
+            )
     return Path(path)
