@@ -212,6 +212,17 @@ void bind_pipeline(nb::module_& m) {
       .def_rw("latency", &pipeline::ReplayOptions::latency)
       .def_rw("fixed_latency_s", &pipeline::ReplayOptions::fixed_latency_s)
       .def_rw("added_delay_s", &pipeline::ReplayOptions::added_delay_s);
+  nb::class_<registration::Degeneracy>(
+      m, "Degeneracy", "How well a registration constrained the body pose (body frame, largest std first).")
+      .def_ro("translation_std_m", &registration::Degeneracy::translation_std_m)
+      .def_ro("translation_axes", &registration::Degeneracy::translation_axes, "principal directions as columns")
+      .def_ro("rotation_std_rad", &registration::Degeneracy::rotation_std_rad)
+      .def_ro("rotation_axes", &registration::Degeneracy::rotation_axes, "principal axes as columns")
+      .def_ro("degenerate_translations", &registration::Degeneracy::degenerate_translations)
+      .def_ro("degenerate_rotations", &registration::Degeneracy::degenerate_rotations)
+      .def_prop_ro("degenerate", &registration::Degeneracy::degenerate)
+      .def("__repr__", attribute_repr({"translation_std_m", "rotation_std_rad", "degenerate_translations",
+                                       "degenerate_rotations"}));
   nb::class_<pipeline::OdometryFrame>(m, "OdometryFrame", "What happened to one scan in the LIO replay.")
       .def_ro("scan", &pipeline::OdometryFrame::scan)
       .def_ro("body_pose", &pipeline::OdometryFrame::body_pose)
@@ -221,6 +232,7 @@ void bind_pipeline(nb::module_& m) {
       .def_ro("started_ns", &pipeline::OdometryFrame::started_ns)
       .def_ro("available_ns", &pipeline::OdometryFrame::available_ns)
       .def_ro("guess_from_fusion", &pipeline::OdometryFrame::guess_from_fusion)
+      .def_ro("degeneracy", &pipeline::OdometryFrame::degeneracy, "Degeneracy of a registered scan, else None")
       .def("__repr__", attribute_repr({"processed", "fused", "drop_reason", "started_ns", "available_ns",
                                        "guess_from_fusion", "body_pose", "scan"}));
   nb::class_<fusion::FusionStats>(m, "FusionStats")
@@ -233,6 +245,7 @@ void bind_pipeline(nb::module_& m) {
       .def_ro("accel_in_g", &fusion::FusionStats::accel_in_g)
       .def_ro("accel_unit_message", &fusion::FusionStats::accel_unit_message)
       .def_ro("gyro_bias_rad_s", &fusion::FusionStats::gyro_bias_rad_s)
+      .def_ro("accel_bias_m_s2", &fusion::FusionStats::accel_bias_m_s2)
       .def_ro("last_warning", &fusion::FusionStats::last_warning)
       .def("__repr__",
            attribute_repr({"steps", "lidar_groups_accepted", "lidar_groups_rejected", "reinitializations", "imu_gaps",

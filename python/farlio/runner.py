@@ -113,6 +113,7 @@ class FrameCounts:
     converged: int = 0
     skipped: int = 0
     dropped: int = 0
+    degenerate: int = 0  # registered frames with a degenerate direction
 
 
 class OdometryRun:
@@ -217,6 +218,7 @@ class OdometryRun:
         self.counts.registered += int(r.registered)
         self.counts.converged += int(r.registered and r.converged)
         self.counts.dropped += int(bool(fr.drop_reason))
+        self.counts.degenerate += int(fr.degeneracy is not None and fr.degeneracy.degenerate)
 
     def export_kitti(self) -> None:
         """LiDAR poses relative to the first, KITTI 3x4."""
@@ -244,6 +246,7 @@ class OdometryRun:
             "skipped": c.skipped,
             "dropped": c.dropped,
             "registered": c.registered,
+            "degenerate": c.degenerate,
             "converged_fraction": c.converged / c.registered if c.registered else float("nan"),
             "latency_ms": {
                 "median": _percentile(totals, MEDIAN_PERCENTILE),
@@ -316,6 +319,7 @@ def _fusion_summary(stats: Any) -> dict[str, Any]:
         "imu_samples_dropped": stats.imu_samples_dropped,
         "accel_in_g": stats.accel_in_g,
         "gyro_bias_rad_s": list(stats.gyro_bias_rad_s),
+        "accel_bias_m_s2": list(stats.accel_bias_m_s2),
     }
 
 

@@ -38,6 +38,10 @@ TIMING_COLUMNS = [
     "guess_from_fusion",
     "latency_ms",
     "drop_reason",
+    "translation_std_max_m",
+    "translation_weak_axis",
+    "rotation_std_max_rad",
+    "degenerate_directions",
 ]
 
 
@@ -75,6 +79,22 @@ def timing_row(index: int, scan: Any, frame: Any) -> dict[str, Any]:
         "guess_from_fusion": int(frame.guess_from_fusion),
         "latency_ms": f"{(frame.available_ns - frame.started_ns) / NS_PER_MS:.3f}",
         "drop_reason": frame.drop_reason,
+        **_degeneracy_fields(frame.degeneracy),
+    }
+
+
+def _degeneracy_fields(d: Any) -> dict[str, Any]:
+    """The registration's largest translation std with its body-frame direction, its largest
+    rotation std, and how many directions exceed the degeneracy thresholds (docs/fusion.md)."""
+    if d is None:
+        return {}
+    axis = d.translation_axes[:, 0]
+    axis = axis if axis[abs(axis).argmax()] >= 0 else -axis  # the sign is arbitrary: largest component positive
+    return {
+        "translation_std_max_m": f"{d.translation_std_m[0]:.4g}",
+        "translation_weak_axis": " ".join(f"{v:+.3f}" for v in axis),
+        "rotation_std_max_rad": f"{d.rotation_std_rad[0]:.4g}",
+        "degenerate_directions": d.degenerate_translations + d.degenerate_rotations,
     }
 
 

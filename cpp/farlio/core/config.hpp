@@ -88,7 +88,14 @@ inline constexpr double kMaxVoxelCapacity = 2147483647.0;
   FIELD(double, convergence_norm, 5e-3, range::positive(), "stop when |dx| (6-vector, m and rad) falls below this") \
   FIELD(double, time_budget_factor, 2.0, range::positive_or_inf(),                                                  \
         "time budget in LiDAR periods (paper: 2); a frame over it is dropped (inf: no budget)")                     \
-  FIELD(double, damping, 1e-9, range::non_negative(), "lambda added to the diagonal of H")
+  FIELD(double, damping, 1e-9, range::non_negative(), "lambda added to the diagonal of H")                          \
+  FIELD(double, covariance_scale, 0.01, range::positive(),                                                          \
+        "pose covariance = covariance_scale * H^-1 (H in the factors' normalised units; docs/fusion.md measures "   \
+        "1e-3..2e-3 on consecutive scans and inflates it for errors shared through the map)")                       \
+  FIELD(double, degenerate_translation_std_m, 0.1, range::positive(),                                               \
+        "a body-frame direction whose translation std (from covariance_scale * H^-1) exceeds this is degenerate")   \
+  FIELD(double, degenerate_rotation_std_rad, 0.01, range::positive(),                                               \
+        "a body-frame axis whose rotation std exceeds this is degenerate")
 
 // ---- fusion: the kinematic EKF (paper eqs. 7-10) fusing IMU inputs with LiDAR poses -------------
 // Variances are given as standard deviations (unit in the name); docs/fusion.md explains each.
@@ -116,9 +123,22 @@ inline constexpr double kMaxVoxelCapacity = 2147483647.0;
   FIELD(double, lidar_yaw_std_rad, 0.01, range::positive(), "LiDAR yaw measurement std")                              \
   FIELD(double, lidar_velocity_std_m_s, 0.8, range::positive(),                                                       \
         "LiDAR body velocity (eq. 6) measurement std per axis")                                                       \
+  FIELD(bool, lidar_information_from_registration, true, range::unchecked(),                                          \
+        "the LiDAR pose is fused with its registration's covariance (registration.covariance_scale * H^-1, "          \
+        "tight where the scene constrains it, loose where degenerate) instead of the fixed lidar_*_std")              \
+  FIELD(double, lidar_min_position_std_m, 0.002, range::positive(),                                                   \
+        "floor of the registration's position std per axis")                                                          \
+  FIELD(double, lidar_min_attitude_std_rad, 2e-4, range::positive(), "floor of the registration's attitude std")      \
+  FIELD(bool, estimate_imu_bias, true, range::unchecked(),                                                            \
+        "gyro and accelerometer biases as filter states (false: the paper's 9-state filter)")                         \
+  FIELD(double, gyro_bias_std_rad_s, 0.01, range::positive(), "initial std of the gyro bias state")                   \
+  FIELD(double, accel_bias_std_m_s2, 0.1, range::positive(), "initial std of the accelerometer bias state")           \
+  FIELD(double, gyro_bias_walk_rad_s2_sqrt_hz, 2e-4, range::non_negative(), "gyro bias random walk density")          \
+  FIELD(double, accel_bias_walk_m_s3_sqrt_hz, 2e-3, range::non_negative(), "accelerometer bias random walk density")  \
   FIELD(bool, outlier_rejection, true, range::unchecked(), "Mahalanobis outlier rejection per measurement group")     \
   FIELD(double, outlier_chi2_3dof, 16.27, range::positive(), "chi-square gate of 3-dof groups (99.9 % quantile)")     \
   FIELD(double, outlier_chi2_2dof, 13.82, range::positive(), "chi-square gate of 2-dof groups (99.9 % quantile)")     \
+  FIELD(double, outlier_chi2_6dof, 22.46, range::positive(), "chi-square gate of 6-dof groups (99.9 % quantile)")     \
   FIELD(int, max_consecutive_rejections, 10, range::at_least(1),                                                      \
         "LiDAR positions rejected in a row before the filter re-initialises from the LiDAR pose")                     \
   FIELD(bool, reference_angles, true, range::unchecked(),                                                             \

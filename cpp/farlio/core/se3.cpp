@@ -79,4 +79,13 @@ double SE3::angle_rad() const {
 
 SE3 interpolate(const SE3& a, const SE3& b, double s) { return a * SE3::exp(s * (a.inverse() * b).log()); }
 
+Mat6d adjoint(const SE3& T) {
+  const Mat3d R = T.rotation();
+  Mat6d A = Mat6d::Zero();
+  A.topLeftCorner<3, 3>() = R;
+  A.topRightCorner<3, 3>() = hat(T.translation()) * R;
+  A.bottomRightCorner<3, 3>() = R;
+  return A;
+}
+
 }  // namespace farlio

@@ -8,6 +8,7 @@
 namespace farlio {
 
 using Vec6d = Eigen::Matrix<double, 6, 1>;
+using Mat6d = Eigen::Matrix<double, 6, 6>;
 using Mat3d = Eigen::Matrix3d;
 using Mat4d = Eigen::Matrix4d;
 
@@ -50,6 +51,10 @@ class SE3 {
   Eigen::Quaterniond q_ = Eigen::Quaterniond::Identity();
   Eigen::Vector3d t_ = Eigen::Vector3d::Zero();
 };
+
+/// The adjoint of T for [rho; phi] tangents: T exp(xi) T^-1 = exp(adjoint(T) xi), i.e.
+/// [[R, hat(t) R], [0, R]]. A right perturbation xi of A becomes adjoint(B^-1) xi of A * B.
+Mat6d adjoint(const SE3& T);
 
 /// Geodesic interpolation a -> b: a * exp(s * log(a^-1 b)) for s in [0, 1] (extrapolates outside).
 SE3 interpolate(const SE3& a, const SE3& b, double s);

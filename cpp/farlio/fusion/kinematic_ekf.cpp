@@ -4,8 +4,12 @@
 
 namespace farlio::fusion {
 
-KinematicEkf::KinematicEkf(double gravity_m_s2, const InputVector& input_variance)
-    : gravity_m_s2_(gravity_m_s2), Q_(input_variance.asDiagonal()) {}
+KinematicEkf::KinematicEkf(double gravity_m_s2, const InputVector& input_variance,
+                           const InputVector& bias_walk_variance)
+    : gravity_m_s2_(gravity_m_s2), Q_(input_variance.asDiagonal()) {
+  bias_walk_.segment<3>(kGyroBiasIndex) = bias_walk_variance.segment<3>(kGyroIndex);
+  bias_walk_.segment<3>(kAccelBiasIndex) = bias_walk_variance.segment<3>(kAccelIndex);
+}
 
 void KinematicEkf::initialize(const StateVector& x, const StateMatrix& P) {
   x_ = normalized_state(x);
@@ -21,6 +25,7 @@ void KinematicEkf::predict(const InputVector& u_start, const InputVector& u_mid,
   const InputMatrix B = dt_s * J.df_du;
   x_ = integrate_step(x_, u_start, u_mid, u_end, dt_s, gravity_m_s2_);
   P_ = A * P_ * A.transpose() + B * Q_ * B.transpose();
+  P_.diagonal() += dt_s * bias_walk_;
   P_ = 0.5 * (P_ + P_.transpose());
 }
 

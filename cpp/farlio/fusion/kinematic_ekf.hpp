@@ -1,7 +1,8 @@
 #pragma once
 // The kinematic EKF (paper eqs. 7-9): RK4 prediction of the state with the IMU as control
-// input, first-order covariance propagation P = A P A^T + B Q B^T with A = I + dt df/dx and
-// B = dt df/du, and Joseph-form updates of measurement groups with a Mahalanobis gate.
+// input, first-order covariance propagation P = A P A^T + B Q B^T + dt Q_bias with A = I + dt df/dx
+// and B = dt df/du (Q_bias: the random walks of the bias states), and Joseph-form updates of
+// measurement groups with a Mahalanobis gate.
 #include <Eigen/Core>
 
 #include "farlio/fusion/kinematic_model.hpp"
@@ -11,8 +12,10 @@ namespace farlio::fusion {
 
 class KinematicEkf {
  public:
-  /// input_variance: the diagonal Q of the input noise [a (m^2/s^4), omega (rad^2/s^2)] over one step.
-  KinematicEkf(double gravity_m_s2, const InputVector& input_variance);
+  /// input_variance: the diagonal Q of the input noise [a (m^2/s^4), omega (rad^2/s^2)] over one step;
+  /// bias_walk_variance: per second, [gyro bias (rad^2/s^3), accel bias (m^2/s^5)] (zero: fixed biases).
+  KinematicEkf(double gravity_m_s2, const InputVector& input_variance,
+               const InputVector& bias_walk_variance = InputVector::Zero());
 
   void initialize(const StateVector& x, const StateMatrix& P);
   [[nodiscard]] bool initialized() const { return initialized_; }
@@ -35,6 +38,7 @@ class KinematicEkf {
  private:
   double gravity_m_s2_;
   Eigen::Matrix<double, kInputDim, kInputDim> Q_;
+  StateVector bias_walk_ = StateVector::Zero();  ///< diagonal of Q_bias per second
   StateVector x_ = StateVector::Zero();
   StateMatrix P_ = StateMatrix::Identity();
   bool initialized_ = false;

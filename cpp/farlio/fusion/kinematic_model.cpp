@@ -14,7 +14,12 @@ double clamped_cos_pitch(double pitch_rad) {
   return std::abs(c) < kMinCosPitch ? std::copysign(kMinCosPitch, c) : c;
 }
 
-/// Euler-rate matrix E(theta): theta' = E(theta) omega_body (ZYX).
+Eigen::Matrix3d rot_x(double a) { return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitX()).toRotationMatrix(); }
+Eigen::Matrix3d rot_y(double a) { return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitY()).toRotationMatrix(); }
+Eigen::Matrix3d rot_z(double a) { return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()).toRotationMatrix(); }
+
+}  // namespace
+
 Eigen::Matrix3d euler_rate_matrix(const Eigen::Vector3d& rpy) {
   const double sr = std::sin(rpy.x()), cr = std::cos(rpy.x());
   const double cp = clamped_cos_pitch(rpy.y()), tp = std::sin(rpy.y()) / cp;
@@ -25,11 +30,12 @@ Eigen::Matrix3d euler_rate_matrix(const Eigen::Vector3d& rpy) {
   return E;
 }
 
-Eigen::Matrix3d rot_x(double a) { return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitX()).toRotationMatrix(); }
-Eigen::Matrix3d rot_y(double a) { return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitY()).toRotationMatrix(); }
-Eigen::Matrix3d rot_z(double a) { return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()).toRotationMatrix(); }
-
-}  // namespace
+InputVector corrected_input(const StateVector& x, const InputVector& u) {
+  InputVector c = u;
+  c.segment<3>(kAccelIndex) -= x.segment<3>(kAccelBiasIndex);
+  c.segment<3>(kGyroIndex) -= x.segment<3>(kGyroBiasIndex);
+  return c;
+}
 
 InputVector make_input(const Eigen::Vector3d& accel_m_s2, const Eigen::Vector3d& gyro_rad_s) {
   InputVector u;
@@ -37,21 +43,23 @@ InputVector make_input(const Eigen::Vector3d& accel_m_s2, const Eigen::Vector3d&
   return u;
 }
 
-StateVector state_derivative(const StateVector& x, const InputVector& u, double gravity_m_s2) {
+StateVector state_derivative(const StateVector& x, const InputVector& u_measured, double gravity_m_s2) {
+  const InputVector u = corrected_input(x, u_measured);
   const Eigen::Vector3d rpy = x.segment<3>(kAttitudeIndex);
   const Eigen::Vector3d v = x.segment<3>(kVelocityIndex);
   const Eigen::Vector3d a = u.segment<3>(kAccelIndex);
   const Eigen::Vector3d w = u.segment<3>(kGyroIndex);
   const Eigen::Matrix3d R = rotation_from_euler(rpy);
   const Eigen::Vector3d g_world(0.0, 0.0, -gravity_m_s2);
-  StateVector dx;
+  StateVector dx = StateVector::Zero();
   dx.segment<3>(kPositionIndex) = R * v;
   dx.segment<3>(kAttitudeIndex) = euler_rate_matrix(rpy) * w;
   dx.segment<3>(kVelocityIndex) = a - w.cross(v) + R.transpose() * g_world;
   return dx;
 }
 
-ModelJacobians model_jacobians(const StateVector& x, const InputVector& u, double gravity_m_s2) {
+ModelJacobians model_jacobians(const StateVector& x, const InputVector& u_measured, double gravity_m_s2) {
+  const InputVector u = corrected_input(x, u_measured);
   const double r = x(kAttitudeIndex), p = x(kAttitudeIndex + 1), y = x(kAttitudeIndex + 2);
   const Eigen::Vector3d v = x.segment<3>(kVelocityIndex);
   const Eigen::Vector3d w = u.segment<3>(kGyroIndex);
@@ -82,6 +90,9 @@ ModelJacobians model_jacobians(const StateVector& x, const InputVector& u, doubl
   J.df_dx.block<3, 3>(kVelocityIndex, kVelocityIndex) = -hat(w);
   J.df_du.block<3, 3>(kVelocityIndex, kAccelIndex) = Eigen::Matrix3d::Identity();
   J.df_du.block<3, 3>(kVelocityIndex, kGyroIndex) = hat(v);
+  // the biases enter as -u
+  J.df_dx.middleCols<3>(kGyroBiasIndex) = -J.df_du.middleCols<3>(kGyroIndex);
+  J.df_dx.middleCols<3>(kAccelBiasIndex) = -J.df_du.middleCols<3>(kAccelIndex);
   return J;
 }
 

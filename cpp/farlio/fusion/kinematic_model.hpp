@@ -1,22 +1,28 @@
 #pragma once
-// The kinematic motion model of the EKF (paper eqs. 7-8): state, input, continuous dynamics,
-// their analytic Jacobians and one integration step.
-//   x = [p_world (3), roll/pitch/yaw ZYX (3), v_body (3)],  u = [a_m (3), omega_m (3)]
+// The kinematic motion model of the EKF (paper eqs. 7-8, with the IMU biases as states): state,
+// input, continuous dynamics, their analytic Jacobians and one integration step.
+//   x = [p_world (3), roll/pitch/yaw ZYX (3), v_body (3), b_gyro (3), b_accel (3)]
+//   u = [a_m (3), omega_m (3)], the IMU input (specific force, angular rate) in the body frame
+//   with a = a_m - b_accel and omega = omega_m - b_gyro:
 //   p'     = R(theta) v
 //   theta' = E(theta) omega
-//   v'     = a_m - omega x v + R(theta)^T g_world,  g_world = (0, 0, -g)
-// u is the bias-corrected IMU input (specific force, angular rate) in the body frame.
+//   v'     = a - omega x v + R(theta)^T g_world,  g_world = (0, 0, -g)
+//   b'     = 0 (random walks: their noise enters the covariance in the EKF)
+// The paper's filter has no bias states; with zero bias covariance and walk the two are the same
+// filter (fusion.estimate_imu_bias=false).
 #include <Eigen/Core>
 
 namespace farlio::fusion {
 
-inline constexpr int kStateDim = 9;
+inline constexpr int kStateDim = 15;
 inline constexpr int kInputDim = 6;
-inline constexpr int kPositionIndex = 0;  ///< p_world in the state
-inline constexpr int kAttitudeIndex = 3;  ///< roll, pitch, yaw in the state
-inline constexpr int kVelocityIndex = 6;  ///< v_body in the state
-inline constexpr int kAccelIndex = 0;     ///< a_m in the input
-inline constexpr int kGyroIndex = 3;      ///< omega_m in the input
+inline constexpr int kPositionIndex = 0;    ///< p_world in the state
+inline constexpr int kAttitudeIndex = 3;    ///< roll, pitch, yaw in the state
+inline constexpr int kVelocityIndex = 6;    ///< v_body in the state
+inline constexpr int kGyroBiasIndex = 9;    ///< b_gyro in the state
+inline constexpr int kAccelBiasIndex = 12;  ///< b_accel in the state
+inline constexpr int kAccelIndex = 0;       ///< a_m in the input
+inline constexpr int kGyroIndex = 3;        ///< omega_m in the input
 /// |cos(pitch)| is clamped to at least this in E(theta) (the gimbal lock at +-90 deg).
 inline constexpr double kMinCosPitch = 1e-9;
 
@@ -27,6 +33,13 @@ using InputMatrix = Eigen::Matrix<double, kStateDim, kInputDim>;
 
 /// u from its parts.
 InputVector make_input(const Eigen::Vector3d& accel_m_s2, const Eigen::Vector3d& gyro_rad_s);
+
+/// u with the state's biases removed: [a_m - b_accel, omega_m - b_gyro].
+InputVector corrected_input(const StateVector& x, const InputVector& u);
+
+/// Euler-rate matrix E(theta): theta' = E(theta) omega_body (ZYX); also the Jacobian of the
+/// angles of R(theta) Exp(delta) with respect to a body-frame rotation delta.
+Eigen::Matrix3d euler_rate_matrix(const Eigen::Vector3d& rpy);
 
 /// f(x, u): the state derivative.
 StateVector state_derivative(const StateVector& x, const InputVector& u, double gravity_m_s2);

@@ -6,10 +6,11 @@ namespace farlio::fusion {
 
 MeasurementSlot slot_of(MeasurementKind kind) {
   switch (kind) {
-    case MeasurementKind::kPosition: return {kPositionIndex, 3, false};
-    case MeasurementKind::kOrientation: return {kAttitudeIndex, 3, true};
-    case MeasurementKind::kVelocity: return {kVelocityIndex, 3, false};
-    case MeasurementKind::kRollPitch: return {kAttitudeIndex, 2, true};
+    case MeasurementKind::kPosition: return {kPositionIndex, 3, 3};
+    case MeasurementKind::kOrientation: return {kAttitudeIndex, 3, 0};
+    case MeasurementKind::kVelocity: return {kVelocityIndex, 3, 3};
+    case MeasurementKind::kRollPitch: return {kAttitudeIndex, 2, 0};
+    case MeasurementKind::kPose: return {kPositionIndex, 6, kAttitudeIndex - kPositionIndex};
   }
   return {};
 }
@@ -21,9 +22,7 @@ Eigen::VectorXd measure(MeasurementKind kind, const StateVector& x) {
 
 Eigen::VectorXd measurement_difference(MeasurementKind kind, const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
   Eigen::VectorXd d = a - b;
-  if (slot_of(kind).is_angle) {
-    for (Eigen::Index i = 0; i < d.size(); ++i) d(i) = wrap_angle(d(i));
-  }
+  for (Eigen::Index i = slot_of(kind).first_angle; i < d.size(); ++i) d(i) = wrap_angle(d(i));
   return d;
 }
 
@@ -40,6 +39,7 @@ const char* kind_name(MeasurementKind kind) {
     case MeasurementKind::kOrientation: return "orientation";
     case MeasurementKind::kVelocity: return "velocity";
     case MeasurementKind::kRollPitch: return "roll/pitch reference";
+    case MeasurementKind::kPose: return "pose";
   }
   return "unknown";
 }

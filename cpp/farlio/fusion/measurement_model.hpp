@@ -1,6 +1,6 @@
 #pragma once
 // The linear-selector measurement models h(x) of the EKF (paper eq. 9): each measurement group
-// observes a contiguous block of the state; angle groups have wrapped residuals.
+// observes a contiguous block of the state; angles have wrapped residuals.
 #include <Eigen/Core>
 
 #include "farlio/fusion/kinematic_model.hpp"
@@ -12,12 +12,13 @@ enum class MeasurementKind {
   kOrientation,  ///< roll, pitch, yaw (3), rad
   kVelocity,     ///< v_body (3), m/s
   kRollPitch,    ///< roll, pitch (2), rad: the reference angles
+  kPose,         ///< p_world (3) and roll, pitch, yaw (3) with one joint covariance
 };
 
 struct MeasurementSlot {
   int first_state_index = 0;
   int dim = 0;
-  bool is_angle = false;
+  int first_angle = 0;  ///< entries [first_angle, dim) are angles (wrapped); dim: none
 };
 
 MeasurementSlot slot_of(MeasurementKind kind);

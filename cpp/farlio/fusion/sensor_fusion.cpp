@@ -8,6 +8,7 @@
 #include "farlio/core/config_fields.hpp"
 #include "farlio/core/time.hpp"
 #include "farlio/fusion/euler.hpp"
+#include "farlio/fusion/lidar_measurement.hpp"
 
 namespace farlio::fusion {
 namespace {
@@ -19,6 +20,16 @@ InputVector input_variance(const FusionConfig& c) {
   InputVector q;
   q << Eigen::Vector3d::Constant(square(c.accel_input_std_m_s2)),
       Eigen::Vector3d::Constant(square(c.gyro_input_std_rad_s));
+  return q;
+}
+
+/// Per second: the bias random walks, zero unless the biases are estimated.
+InputVector bias_walk_variance(const FusionConfig& c) {
+  InputVector q = InputVector::Zero();
+  if (c.estimate_imu_bias) {
+    q << Eigen::Vector3d::Constant(square(c.accel_bias_walk_m_s3_sqrt_hz)),
+        Eigen::Vector3d::Constant(square(c.gyro_bias_walk_rad_s2_sqrt_hz));
+  }
   return q;
 }
 
@@ -37,7 +48,7 @@ SensorFusion::SensorFusion(const FusionConfig& config, double gravity_m_s2)
     : config_(validated(config)),
       gravity_m_s2_(gravity_m_s2),
       step_ns_(seconds_to_ns(config.step_s)),
-      ekf_(gravity_m_s2, input_variance(config)),
+      ekf_(gravity_m_s2, input_variance(config), bias_walk_variance(config)),
       imu_(config.imu_gap_limit_s, config.history_s),
       accel_unit_(config.accel_unit_detection, config.accel_unit_detection_samples, gravity_m_s2),
       bias_(config, gravity_m_s2),
@@ -56,7 +67,8 @@ void SensorFusion::record_correction(const StateVector& before) {
 
 double SensorFusion::gate(int dim) const {
   if (!config_.outlier_rejection) return 0.0;
-  return dim == 2 ? config_.outlier_chi2_2dof : config_.outlier_chi2_3dof;
+  if (dim == 2) return config_.outlier_chi2_2dof;
+  return dim == 6 ? config_.outlier_chi2_6dof : config_.outlier_chi2_3dof;
 }
 
 void SensorFusion::add_imu(const ImuSample& sample) {
@@ -116,8 +128,9 @@ void SensorFusion::step() {
 
 void SensorFusion::fuse_reference_angles(std::int64_t stamp_ns) {
   const StateVector& x = ekf_.state();
-  const auto angles = reference_.push(stamp_ns, x.segment<3>(kVelocityIndex), last_input_.segment<3>(kAccelIndex),
-                                      last_input_.segment<3>(kGyroIndex));
+  const InputVector u = corrected_last_input();
+  const auto angles =
+      reference_.push(stamp_ns, x.segment<3>(kVelocityIndex), u.segment<3>(kAccelIndex), u.segment<3>(kGyroIndex));
   if (!angles) return;
   if (angles->saturated) {  // a clamped asin is only a bound on the angle: not fused
     ++stats_.reference_angles_rejected;
@@ -142,14 +155,30 @@ void SensorFusion::fuse_reference_angles(std::int64_t stamp_ns) {
 void SensorFusion::initialize(std::int64_t stamp_ns, const SE3& pose, const Eigen::Vector3d& velocity,
                               bool velocity_known) {
   accel_unit_.decide();
-  StateVector x;
-  x << pose.translation(), euler_from_rotation(pose.rotation()), velocity_known ? velocity : Eigen::Vector3d::Zero();
-  StateVector variance;
-  variance << Eigen::Vector3d::Constant(square(config_.initial_position_std_m)),
-      Eigen::Vector3d::Constant(square(config_.initial_attitude_std_rad)),
-      Eigen::Vector3d::Constant(
-          square(velocity_known ? config_.lidar_velocity_std_m_s : config_.initial_velocity_std_m_s));
-  ekf_.initialize(x, variance.asDiagonal());
+  // a re-initialisation keeps the bias estimates and their uncertainty
+  const bool keep_biases = ekf_.initialized();
+  const StateVector previous = ekf_.state();
+  const StateMatrix previous_P = ekf_.covariance();
+  StateVector x = StateVector::Zero();
+  x.segment<3>(kPositionIndex) = pose.translation();
+  x.segment<3>(kAttitudeIndex) = euler_from_rotation(pose.rotation());
+  if (velocity_known) x.segment<3>(kVelocityIndex) = velocity;
+  StateVector variance = StateVector::Zero();
+  variance.segment<3>(kPositionIndex).setConstant(square(config_.initial_position_std_m));
+  variance.segment<3>(kAttitudeIndex).setConstant(square(config_.initial_attitude_std_rad));
+  variance.segment<3>(kVelocityIndex)
+      .setConstant(square(velocity_known ? config_.lidar_velocity_std_m_s : config_.initial_velocity_std_m_s));
+  if (config_.estimate_imu_bias) {
+    variance.segment<3>(kGyroBiasIndex).setConstant(square(config_.gyro_bias_std_rad_s));
+    variance.segment<3>(kAccelBiasIndex).setConstant(square(config_.accel_bias_std_m_s2));
+  }
+  StateMatrix P = variance.asDiagonal();
+  if (keep_biases) {
+    constexpr int kBiasStates = kStateDim - kGyroBiasIndex;
+    x.tail<kBiasStates>() = previous.tail<kBiasStates>();
+    P.bottomRightCorner<kBiasStates, kBiasStates>() = previous_P.bottomRightCorner<kBiasStates, kBiasStates>();
+  }
+  ekf_.initialize(x, P);
   time_ns_ = stamp_ns;
   history_.clear();
   cumulative_correction_.setZero();
@@ -169,7 +198,9 @@ int SensorFusion::spread_steps(std::int64_t measured_at_ns) const {
 }
 
 LidarUpdateResult SensorFusion::add_lidar(std::int64_t measured_at_ns, const SE3& body_pose,
-                                          const Eigen::Vector3d& body_velocity_m_s, bool use_velocity) {
+                                          const Eigen::Vector3d& body_velocity_m_s, bool use_velocity,
+                                          const std::optional<Mat6d>& body_covariance,
+                                          const std::optional<Eigen::Matrix3d>& velocity_covariance) {
   LidarUpdateResult result;
   if (!initialized()) {
     initialize(measured_at_ns, body_pose, body_velocity_m_s, use_velocity);
@@ -178,15 +209,20 @@ LidarUpdateResult SensorFusion::add_lidar(std::int64_t measured_at_ns, const SE3
     return result;
   }
   std::vector<LidarGroup> groups;
-  groups.push_back({MeasurementKind::kPosition, body_pose.translation(),
-                    Eigen::Matrix3d::Identity() * square(config_.lidar_position_std_m)});
-  groups.push_back({MeasurementKind::kOrientation, euler_from_rotation(body_pose.rotation()),
-                    Eigen::Vector3d(square(config_.lidar_roll_pitch_std_rad), square(config_.lidar_roll_pitch_std_rad),
-                                    square(config_.lidar_yaw_std_rad))
-                        .asDiagonal()});
+  const Eigen::Vector3d angles = euler_from_rotation(body_pose.rotation());
+  if (body_covariance && config_.lidar_information_from_registration) {
+    Vec6d z;
+    z << body_pose.translation(), angles;
+    groups.push_back({MeasurementKind::kPose, z, pose_measurement_covariance(*body_covariance, body_pose, config_)});
+  } else {  // the paper's fixed noise, position and orientation gated separately
+    const Mat6d R = fixed_pose_covariance(config_);
+    groups.push_back({MeasurementKind::kPosition, body_pose.translation(), R.topLeftCorner<3, 3>()});
+    groups.push_back({MeasurementKind::kOrientation, angles, R.bottomRightCorner<3, 3>()});
+  }
   if (use_velocity) {
-    groups.push_back({MeasurementKind::kVelocity, body_velocity_m_s,
-                      Eigen::Matrix3d::Identity() * square(config_.lidar_velocity_std_m_s)});
+    groups.push_back(
+        {MeasurementKind::kVelocity, body_velocity_m_s,
+         velocity_covariance.value_or(Eigen::Matrix3d::Identity() * square(config_.lidar_velocity_std_m_s))});
   }
   const int injections = spread_steps(measured_at_ns);
   last_lidar_ns_ = measured_at_ns;
@@ -215,8 +251,10 @@ LidarUpdateResult SensorFusion::add_lidar(std::int64_t measured_at_ns, const SE3
       warn(std::string("LiDAR ") + kind_name(g.kind) + " rejected as an outlier at " + std::to_string(measured_at_ns) +
            " ns");
     }
-    if (g.kind == MeasurementKind::kPosition) result.position_accepted = accepted;
-    if (g.kind == MeasurementKind::kOrientation) result.orientation_accepted = accepted;
+    if (g.kind == MeasurementKind::kPosition || g.kind == MeasurementKind::kPose) result.position_accepted = accepted;
+    if (g.kind == MeasurementKind::kOrientation || g.kind == MeasurementKind::kPose) {
+      result.orientation_accepted = accepted;
+    }
     if (g.kind == MeasurementKind::kVelocity) result.velocity_accepted = accepted;
   }
   consecutive_rejections_ = result.position_accepted ? 0 : consecutive_rejections_ + 1;
@@ -255,6 +293,11 @@ FusionStats SensorFusion::stats() const {
   s.accel_in_g = accel_unit_.in_g();
   s.accel_unit_message = accel_unit_.message();
   s.gyro_bias_rad_s = bias_.bias_rad_s();
+  s.accel_bias_m_s2 = accel_bias_m_s2_;
+  if (initialized()) {
+    s.gyro_bias_rad_s += ekf_.state().segment<3>(kGyroBiasIndex);
+    s.accel_bias_m_s2 += ekf_.state().segment<3>(kAccelBiasIndex);
+  }
   s.bias_samples = static_cast<std::int64_t>(bias_.sample_count());
   return s;
 }

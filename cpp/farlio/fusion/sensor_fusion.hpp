@@ -34,12 +34,13 @@ struct FusionStats {
   std::int64_t lidar_too_old = 0;          ///< older than the state history: rejected
   std::int64_t reinitializations = 0;      ///< after max_consecutive_rejections
   std::int64_t reference_angles_accepted = 0;
-  std::int64_t reference_angles_rejected = 0;  ///< gated or saturated
-  std::int64_t imu_gaps = 0;                   ///< gap events (each held-input stretch counts once)
-  std::int64_t imu_samples_dropped = 0;        ///< older than the newest sample
-  bool accel_in_g = false;                     ///< the accelerometer was detected to report in g
-  std::string accel_unit_message;              ///< printable note when accel_in_g
-  Eigen::Vector3d gyro_bias_rad_s = Eigen::Vector3d::Zero();
+  std::int64_t reference_angles_rejected = 0;                 ///< gated or saturated
+  std::int64_t imu_gaps = 0;                                  ///< gap events (each held-input stretch counts once)
+  std::int64_t imu_samples_dropped = 0;                       ///< older than the newest sample
+  bool accel_in_g = false;                                    ///< the accelerometer was detected to report in g
+  std::string accel_unit_message;                             ///< printable note when accel_in_g
+  Eigen::Vector3d gyro_bias_rad_s = Eigen::Vector3d::Zero();  ///< standstill estimate + filter state
+  Eigen::Vector3d accel_bias_m_s2 = Eigen::Vector3d::Zero();  ///< configured + filter state
   std::int64_t bias_samples = 0;
   std::string last_warning;  ///< the most recent warning, empty if none
 };
@@ -64,10 +65,17 @@ class SensorFusion {
   void advance_to(std::int64_t stamp_ns);
   /// A LiDAR result for the scan-end stamp measured_at_ns, delivered at the current filter time
   /// (the difference is its delay). The first one initialises the filter.
+  /// body_covariance: the registration's covariance of a right perturbation [t; r] of body_pose
+  /// (registration/degeneracy.hpp); fused as one pose group when given and
+  /// lidar_information_from_registration, else the fixed lidar_*_std apply. velocity_covariance:
+  /// of the body velocity (lidar_measurement.hpp); empty: lidar_velocity_std_m_s.
   LidarUpdateResult add_lidar(std::int64_t measured_at_ns, const SE3& body_pose,
-                              const Eigen::Vector3d& body_velocity_m_s, bool use_velocity);
+                              const Eigen::Vector3d& body_velocity_m_s, bool use_velocity,
+                              const std::optional<Mat6d>& body_covariance = std::nullopt,
+                              const std::optional<Eigen::Matrix3d>& velocity_covariance = std::nullopt);
 
   [[nodiscard]] bool initialized() const { return ekf_.initialized(); }
+  [[nodiscard]] const FusionConfig& config() const { return config_; }
   /// The filter step (FusionConfig::step_s) in ns.
   [[nodiscard]] std::int64_t step_ns() const { return step_ns_; }
   [[nodiscard]] BodyEstimate estimate() const;
@@ -75,13 +83,15 @@ class SensorFusion {
   /// max_extrapolation_s beyond the newest step; nullopt otherwise.
   [[nodiscard]] std::optional<SE3> pose_at(std::int64_t stamp_ns) const;
   /// The bias-corrected angular rate used in the last step (rad/s, body frame).
-  [[nodiscard]] Eigen::Vector3d angular_velocity_body() const { return last_input_.segment<3>(kGyroIndex); }
+  [[nodiscard]] Eigen::Vector3d angular_velocity_body() const { return corrected_last_input().segment<3>(kGyroIndex); }
   [[nodiscard]] FusionStats stats() const;
 
  private:
   void initialize(std::int64_t stamp_ns, const SE3& pose, const Eigen::Vector3d& velocity, bool velocity_known);
   void step();
   [[nodiscard]] InputVector input_of(const ImuReading& r) const;
+  /// The last input with the filter's bias estimates removed.
+  [[nodiscard]] InputVector corrected_last_input() const { return corrected_input(ekf_.state(), last_input_); }
   void fuse_reference_angles(std::int64_t stamp_ns);
   [[nodiscard]] int spread_steps(std::int64_t measured_at_ns) const;
   [[nodiscard]] double gate(int dim) const;

@@ -5,6 +5,7 @@
 
 #include "farlio/core/time.hpp"
 #include "farlio/deskew/motion_fit.hpp"
+#include "farlio/fusion/lidar_measurement.hpp"
 
 namespace farlio::pipeline {
 namespace {
@@ -55,9 +56,9 @@ std::string drop_reason(const FrameResult& result, bool map_started) {
   return {};
 }
 
-FusionDriver::FusionDriver(const FusionConfig& config, double gravity_m_s2, const SE3& T_imu_lidar, bool inertial)
-    : T_imu_lidar_(T_imu_lidar) {
-  if (inertial) fusion_.emplace(config, gravity_m_s2);
+FusionDriver::FusionDriver(const Config& config, double gravity_m_s2, const SE3& T_imu_lidar, bool inertial)
+    : registration_config_(config.registration), T_imu_lidar_(T_imu_lidar) {
+  if (inertial) fusion_.emplace(config.fusion, gravity_m_s2);
 }
 
 void FusionDriver::emit_step(Samples& out) {
@@ -101,17 +102,30 @@ ScanPrior FusionDriver::prior(const Scan& scan) const {
 
 void FusionDriver::link(const Scan& scan, OdometryFrame& frame) {
   frame.drop_reason = drop_reason(frame.scan, last_body_.has_value());
+  std::optional<Mat6d> covariance;
+  if (frame.scan.registered && frame.scan.registration.system.inliers > 0) {
+    covariance = registration::covariance_from_information(registration::body_information(
+        frame.scan.registration.system.H, T_imu_lidar_, registration_config_.covariance_scale));
+    frame.degeneracy = registration::analyze_degeneracy(*covariance, registration_config_);
+  }
   if (frame.drop_reason.empty() && fusion_) {
     const std::int64_t stamp_ns = scan.end_stamp_ns;
     Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+    std::optional<Eigen::Matrix3d> velocity_covariance;
     const bool has_velocity = last_body_.has_value() && stamp_ns > last_body_->stamp_ns;
     if (has_velocity) {  // eq. (6) on the body poses
-      velocity = velocity_from_poses(last_body_->pose, frame.body_pose, ns_to_seconds(stamp_ns - last_body_->stamp_ns));
+      const double dt_s = ns_to_seconds(stamp_ns - last_body_->stamp_ns);
+      velocity = velocity_from_poses(last_body_->pose, frame.body_pose, dt_s);
+      if (covariance && last_covariance_) {
+        velocity_covariance =
+            fusion::velocity_measurement_covariance(*covariance, *last_covariance_, dt_s, fusion_->config());
+      }
     }
-    fusion_->add_lidar(stamp_ns, frame.body_pose, velocity, has_velocity);
+    fusion_->add_lidar(stamp_ns, frame.body_pose, velocity, has_velocity, covariance, velocity_covariance);
     frame.fused = true;
   }
   last_body_ = StampedPose{scan.end_stamp_ns, frame.body_pose};
+  last_covariance_ = covariance;
 }
 
 std::optional<fusion::FusionStats> FusionDriver::stats() const {

@@ -8,8 +8,9 @@
 //   before a scan: the start pose (roll and pitch from gravity) at the first scan, the fusion's
 //     pose at the scan end as the initial guess, and a regression over its pose history during
 //     the scan as the motion for the undistortion;
-//   after a scan: the drop rules, then the registered body pose and the eq. (6) velocity go into
-//     the fusion as a (possibly delayed) measurement.
+//   after a scan: the drop rules, the registration's covariance in the body frame and its
+//     degeneracy, then the registered body pose and the eq. (6) velocity go into the fusion as a
+//     (possibly delayed) measurement with that covariance.
 // Without the fusion (LiDAR-only odometry) the clock is idle, the prior is empty and nothing is
 // fused; the drop rules still apply.
 #include <cstdint>
@@ -48,7 +49,7 @@ class FusionDriver {
   using Samples = std::vector<OdometrySample>;
 
   /// With `inertial` false the driver runs LiDAR-only (no fusion).
-  FusionDriver(const FusionConfig& config, double gravity_m_s2, const SE3& T_imu_lidar, bool inertial);
+  FusionDriver(const Config& config, double gravity_m_s2, const SE3& T_imu_lidar, bool inertial);
 
   /// Feeds one IMU sample (in time order): appends to `out` the odometry sample of every output
   /// instant before the sample's stamp, then of the one at its stamp.
@@ -71,9 +72,9 @@ class FusionDriver {
   /// The initial guess and the motion during the scan, from the fusion (empty: LiDAR-only, or
   /// before the filter is initialised).
   [[nodiscard]] ScanPrior prior(const Scan& scan) const;
-  /// After the scan pipeline (frame.scan and frame.body_pose set): sets frame.drop_reason and,
-  /// unless dropped and when inertial, fuses the result at the current clock (frame.fused,
-  /// frame.available_ns = the fusion's time).
+  /// After the scan pipeline (frame.scan and frame.body_pose set): sets frame.drop_reason and
+  /// frame.degeneracy and, unless dropped and when inertial, fuses the result at the current clock
+  /// (frame.fused).
   void link(const Scan& scan, OdometryFrame& frame);
 
   [[nodiscard]] std::optional<fusion::FusionStats> stats() const;
@@ -82,12 +83,14 @@ class FusionDriver {
   /// Steps the filter to the next output instant and appends its estimate.
   void emit_step(Samples& out);
 
+  RegistrationConfig registration_config_;
   SE3 T_imu_lidar_;
   std::optional<fusion::SensorFusion> fusion_;
   std::vector<ImuSample> startup_imu_;  ///< the first kGravityAlignmentWindow_s, for the start pose
   std::int64_t clock_ns_ = 0;
   std::int64_t next_output_ns_ = 0;       ///< 0: set by the first IMU sample
   std::optional<StampedPose> last_body_;  ///< the previous processed scan's body pose
+  std::optional<Mat6d> last_covariance_;  ///< and its registration covariance
 };
 
 }  // namespace farlio::pipeline

@@ -12,7 +12,7 @@ Odometry::Odometry(const Config& config, const SE3& T_imu_lidar, double gravity_
       T_imu_lidar_(T_imu_lidar),
       T_lidar_imu_(T_imu_lidar.inverse()),
       imu_(std::move(imu)),
-      driver_(config.fusion, gravity_m_s2, T_imu_lidar, config.fusion.enabled && !imu_.empty()),
+      driver_(config, gravity_m_s2, T_imu_lidar, config.fusion.enabled && !imu_.empty()),
       pipeline_(config, T_imu_lidar) {
   if (driver_.inertial()) {
     // the clock starts at the first IMU sample, so the fusion sees every sample before the

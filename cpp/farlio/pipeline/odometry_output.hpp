@@ -4,10 +4,12 @@
 // online odometry (online_odometry.hpp) report the same types.
 #include <Eigen/Core>
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "farlio/core/se3.hpp"
 #include "farlio/pipeline/scan_pipeline.hpp"
+#include "farlio/registration/degeneracy.hpp"
 
 namespace farlio::pipeline {
 
@@ -21,6 +23,8 @@ struct OdometryFrame {
   std::int64_t started_ns = 0;     ///< when the pipeline started on it (the odometry's clock)
   std::int64_t available_ns = 0;   ///< when its result reached the fusion
   bool guess_from_fusion = false;  ///< initial guess and undistortion came from the fusion
+  /// How well the registration constrained the body pose (registered scans only).
+  std::optional<registration::Degeneracy> degeneracy;
 };
 
 /// One sample of the 100 Hz odometry output.

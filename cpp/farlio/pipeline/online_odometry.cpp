@@ -12,7 +12,7 @@ OnlineOdometry::OnlineOdometry(const Config& config, const SE3& T_imu_lidar, dou
       T_lidar_imu_(T_imu_lidar.inverse()),
       on_odometry_(std::move(on_odometry)),
       on_frame_(std::move(on_frame)),
-      driver_(config.fusion, gravity_m_s2, T_imu_lidar, config.fusion.enabled) {
+      driver_(config, gravity_m_s2, T_imu_lidar, config.fusion.enabled) {
   worker_ = std::thread([this] { worker_loop(); });
 }
 

@@ -1,0 +1,59 @@
+#include "farlio/registration/degeneracy.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+
+namespace farlio::registration {
+namespace {
+
+struct Principal {
+  Eigen::Vector3d std;
+  Eigen::Matrix3d axes;
+};
+
+/// Principal stds of a 3x3 covariance, largest first.
+Principal principal_stds(const Eigen::Matrix3d& covariance) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(0.5 * (covariance + covariance.transpose()));
+  Principal p;
+  for (int i = 0; i < 3; ++i) {  // eigenvalues ascending: reverse
+    p.std(i) = std::sqrt(std::max(0.0, es.eigenvalues()(2 - i)));
+    p.axes.col(i) = es.eigenvectors().col(2 - i);
+  }
+  return p;
+}
+
+int count_over(const Eigen::Vector3d& stds, double threshold) {
+  return static_cast<int>((stds.array() > threshold).count());
+}
+
+}  // namespace
+
+Mat6d body_information(const Mat6d& H_sensor, const SE3& T_body_sensor, double covariance_scale) {
+  // a right perturbation xi of the sensor pose is adjoint(T_body_sensor) xi of the body pose
+  const Mat6d A_inv = adjoint(T_body_sensor.inverse());
+  const Mat6d H = A_inv.transpose() * H_sensor * A_inv / covariance_scale;
+  return 0.5 * (H + H.transpose());
+}
+
+Mat6d covariance_from_information(const Mat6d& information) {
+  const Eigen::SelfAdjointEigenSolver<Mat6d> es(information);
+  const double min_information = 1.0 / (kUnconstrainedStd * kUnconstrainedStd);
+  const Vec6d inverse = es.eigenvalues().cwiseMax(min_information).cwiseInverse();
+  return es.eigenvectors() * inverse.asDiagonal() * es.eigenvectors().transpose();
+}
+
+Degeneracy analyze_degeneracy(const Mat6d& covariance, const RegistrationConfig& config) {
+  const Principal t = principal_stds(covariance.topLeftCorner<3, 3>());
+  const Principal r = principal_stds(covariance.bottomRightCorner<3, 3>());
+  Degeneracy d;
+  d.translation_std_m = t.std;
+  d.translation_axes = t.axes;
+  d.rotation_std_rad = r.std;
+  d.rotation_axes = r.axes;
+  d.degenerate_translations = count_over(t.std, config.degenerate_translation_std_m);
+  d.degenerate_rotations = count_over(r.std, config.degenerate_rotation_std_rad);
+  return d;
+}
+
+}  // namespace farlio::registration

@@ -1,0 +1,40 @@
+#pragma once
+// How well a registration constrains the pose, from its Gauss-Newton H: the pose covariance
+// covariance_scale * H^-1 moved into the body (IMU) frame, and per block (translation, rotation)
+// the marginal std along each principal direction. A direction whose std exceeds the
+// registration's degenerate_* threshold is degenerate: the scene does not fix the pose along it
+// (a tunnel along its axis, a plane's in-plane directions). The fusion then takes that direction
+// from the IMU prior (docs/fusion.md, "Degeneracy").
+#include <Eigen/Core>
+
+#include "farlio/core/config.hpp"
+#include "farlio/core/se3.hpp"
+
+namespace farlio::registration {
+
+/// The pose information [translation; rotation] of a right perturbation of the body pose, in
+/// physical units (1/m^2, 1/rad^2): H of a right perturbation of the sensor pose (normalised
+/// units) moved through T_body_sensor and divided by covariance_scale.
+Mat6d body_information(const Mat6d& H_sensor, const SE3& T_body_sensor, double covariance_scale);
+
+/// Its inverse, with directions the information does not constrain at all capped at
+/// kUnconstrainedStd (a finite covariance the fusion can still use).
+Mat6d covariance_from_information(const Mat6d& information);
+inline constexpr double kUnconstrainedStd = 1e3;  ///< m or rad
+
+struct Degeneracy {
+  /// Marginal std along the principal directions, largest first (m, rad), and those directions
+  /// (columns, body frame).
+  Eigen::Vector3d translation_std_m = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d translation_axes = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d rotation_std_rad = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d rotation_axes = Eigen::Matrix3d::Identity();
+  int degenerate_translations = 0;  ///< directions over the threshold
+  int degenerate_rotations = 0;
+  [[nodiscard]] bool degenerate() const { return degenerate_translations + degenerate_rotations > 0; }
+};
+
+/// The principal stds of the marginal covariance blocks of `covariance` ([t; r], body frame).
+Degeneracy analyze_degeneracy(const Mat6d& covariance, const RegistrationConfig& config);
+
+}  // namespace farlio::registration

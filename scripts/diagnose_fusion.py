@@ -1,0 +1,182 @@
+#!/usr/bin/env python3
+"""Where does the fusion lose accuracy? Runs the deterministic replay on generated sequences with one
+fusion part changed at a time and prints, per variant, the accuracy of the registered scan poses
+against the exact ground truth, next to LiDAR-only on the same data (docs/fusion.md, "Diagnosis").
+
+Each variant isolates one part of the fusion:
+  lidar_only      no fusion (the reference the LIO must not be worse than)
+  lio             the defaults
+  ideal_imu       the same scans, the IMU of the noise-free generator (no noise, no bias)
+  ideal_gyro      ideal gyro, noisy accelerometer
+  ideal_accel     noisy gyro, ideal accelerometer
+  no_ref_angles   fusion.reference_angles=false
+  no_delay_comp   fusion.delay_compensation=false
+  no_spread       fusion.update_spread_steps=1 (each LiDAR result in one update)
+  no_bias         fusion.standstill_bias=false
+  fixed_noise     the LiDAR measurement from the fixed fusion.lidar_*_std values instead of the
+                  registration's information matrix
+Columns: APE (m), rotation RMSE (deg) and KITTI-style RPE (%) of the scan poses (body frame), the
+end drift with the first pose aligned (m), the median rotation error of the initial guess the
+fusion gave the registration (deg; "-" without fusion) and the rotation RMSE of the 100 Hz fused
+odometry (deg).
+
+  python scripts/diagnose_fusion.py --profile racetrack --duration 30 --seeds 1 2 \
+      [--variants lio lidar_only ...] [--set name=value ...]
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import statistics
+import sys
+import tempfile
+from pathlib import Path
+
+import farlio  # noqa: F401  (loads the extension)
+import numpy as np
+from farlio import _core
+from farlio.evaluation import make_options
+from farlio.simulation import generate
+
+FIXED_LATENCY_S = 0.02  # the accuracy tables' latency model (scripts/measure_accuracy.py)
+
+VARIANTS: dict[str, tuple[dict[str, str], str]] = {
+    # name: (config overrides, IMU source)
+    "lidar_only": ({"fusion.enabled": "false"}, "noisy"),
+    "lio": ({}, "noisy"),
+    "ideal_imu": ({}, "ideal"),
+    "ideal_gyro": ({}, "ideal_gyro"),
+    "ideal_accel": ({}, "ideal_accel"),
+    "no_ref_angles": ({"fusion.reference_angles": "false"}, "noisy"),
+    "no_delay_comp": ({"fusion.delay_compensation": "false"}, "noisy"),
+    "no_spread": ({"fusion.update_spread_steps": "1"}, "noisy"),
+    "no_bias": ({"fusion.standstill_bias": "false"}, "noisy"),
+    "tight_lidar": ({"fusion.lidar_roll_pitch_std_rad": "0.002", "fusion.lidar_yaw_std_rad": "0.002"}, "noisy"),
+    "tight_convergence": ({"registration.convergence_norm": "0.001"}, "noisy"),
+    "fixed_noise": ({"fusion.lidar_information_from_registration": "false"}, "noisy"),
+}
+
+
+def rotation_angle_deg(a, b) -> float:
+    """Angle of the rotation between two SE3 poses (deg)."""
+    return math.degrees((a.inverse() * b).angle_rad())
+
+
+def mixed_imu(noisy: list, ideal: list, source: str) -> list:
+    if source == "noisy":
+        return noisy
+    if source == "ideal":
+        return ideal
+    out = []
+    for n, i in zip(noisy, ideal, strict=True):
+        s = _core.ImuSample()
+        s.stamp_ns = n.stamp_ns
+        s.gyro_rad_s = i.gyro_rad_s if source == "ideal_gyro" else n.gyro_rad_s
+        s.accel_m_s2 = i.accel_m_s2 if source == "ideal_gyro" else n.accel_m_s2
+        if source == "ideal_accel":
+            s.gyro_rad_s, s.accel_m_s2 = n.gyro_rad_s, i.accel_m_s2
+        out.append(s)
+    return out
+
+
+def poses(trajectory) -> list:
+    return [trajectory[i][1] for i in range(len(trajectory))]
+
+
+class Sequence:
+    """A generated sequence (written once to a cache folder and read back): scans, the noisy and
+    the ideal IMU, ground truth."""
+
+    def __init__(self, profile: str, seed: int, duration_s: float, cache: Path):
+        folder = cache / f"{profile}_seed{seed}_{duration_s:g}s"
+        if not (folder / "meta.yaml").exists():
+            generate(profile, folder, seed=seed, duration_s=duration_s)
+        cfg = _core.sim.default_config(profile)
+        cfg.seed, cfg.duration_s, cfg.noise_free = seed, duration_s, True
+        self.ideal_imu = _core.sim.SequenceGenerator(cfg).imu()
+        reader = _core.io.SequenceReader(folder)
+        self.imu = reader.imu()
+        calib = reader.calibration()
+        self.T_imu_lidar = calib.T_imu_lidar
+        self.gravity_m_s2 = calib.gravity_m_s2
+        self.scans = [reader.read_scan(i) for i in range(reader.num_scans())]
+        self.gt_scans = reader.groundtruth_scans()
+        self.gt_body = reader.groundtruth()
+
+
+def run_variant(seq: Sequence, overrides: dict[str, str], imu_source: str) -> dict[str, float]:
+    config = _core.Config()
+    for name, value in overrides.items():
+        config.set(name, value)
+    options = _core.ReplayOptions()
+    options.latency = _core.LatencyModel.Fixed
+    options.fixed_latency_s = FIXED_LATENCY_S
+    imu = mixed_imu(seq.imu, seq.ideal_imu, imu_source) if config.get("fusion.enabled") else []
+    odo = _core.Odometry(config, seq.T_imu_lidar, seq.gravity_m_s2, imu, options)
+    T_lidar_imu = seq.T_imu_lidar.inverse()
+    scans, odometry = _core.Trajectory(), _core.Trajectory()
+    guess_errors = []
+    to_gt = None  # odometry world -> generator world, from the first scan
+    for scan, gt_scan in zip(seq.scans, poses(seq.gt_scans), strict=True):
+        fr = odo.process(scan)
+        for stamp, pose in odo.take_odometry():
+            odometry.push_back(stamp, pose)
+        if not fr.processed:
+            continue
+        scans.push_back(scan.end_stamp_ns, fr.body_pose)
+        if to_gt is None:
+            to_gt = gt_scan * fr.body_pose.inverse()
+        if fr.guess_from_fusion:
+            guess_errors.append(rotation_angle_deg(to_gt * fr.scan.initial_guess * T_lidar_imu, gt_scan))
+    odo.finish(seq.scans[-1].end_stamp_ns)
+    for stamp, pose in odo.take_odometry():
+        odometry.push_back(stamp, pose)
+    options = make_options()
+    r = _core.eval.evaluate(scans, seq.gt_scans, options)
+    first = poses(seq.gt_scans)[0] * poses(scans)[0].inverse()  # first pose aligned
+    end_drift = np.linalg.norm((first * poses(scans)[-1]).translation - poses(seq.gt_scans)[-1].translation)
+    row = {
+        "ape_m": r.ape.translation_m.rmse,
+        "rot_deg": r.ape.rotation_deg.rmse,
+        "rpe_pct": r.kitti_rpe.translation_pct,
+        "end_drift_m": float(end_drift),
+        "guess_rot_deg": statistics.median(guess_errors) if guess_errors else math.nan,
+        "odom_rot_deg": math.nan,
+    }
+    if len(odometry) > 1:
+        row["odom_rot_deg"] = _core.eval.evaluate(odometry, seq.gt_body, options).ape.rotation_deg.rmse
+    return row
+
+
+def main() -> int:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--profile", default="racetrack", help="generator profile")
+    p.add_argument("--seeds", type=int, nargs="+", default=[1, 2], help="noise seeds")
+    p.add_argument("--duration", type=float, default=30.0, help="sequence length (s)")
+    p.add_argument("--variants", nargs="+", default=list(VARIANTS), choices=list(VARIANTS), help="what to run")
+    p.add_argument(
+        "--cache", type=Path, default=Path(tempfile.gettempdir()) / "farlio_diagnose", help="generated sequences"
+    )
+    p.add_argument("--set", nargs="*", default=[], metavar="NAME=VALUE", help="config fields for every variant")
+    args = p.parse_args()
+    common = dict(item.split("=", 1) for item in args.set)
+    print(
+        f"{'seed':>4} {'variant':<14} {'APE m':>8} {'rot deg':>8} {'RPE %':>7} {'drift m':>8} "
+        f"{'guess deg':>9} {'odom deg':>8}"
+    )
+    for seed in args.seeds:
+        seq = Sequence(args.profile, seed, args.duration, args.cache)
+        for name in args.variants:
+            overrides, imu_source = VARIANTS[name]
+            r = run_variant(seq, {**common, **overrides}, imu_source)
+            print(
+                f"{seed:>4} {name:<14} {r['ape_m']:8.3f} {r['rot_deg']:8.3f} {r['rpe_pct']:7.3f} "
+                f"{r['end_drift_m']:8.2f} {r['guess_rot_deg']:9.3f} {r['odom_rot_deg']:8.3f}",
+                flush=True,
+            )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
