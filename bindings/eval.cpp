@@ -51,6 +51,10 @@ void bind_options(nb::module_& m) {
   nb::enum_<AssociationMode>(m, "AssociationMode")
       .value("INTERPOLATE", AssociationMode::kInterpolate)
       .value("NEAREST", AssociationMode::kNearest);
+  nb::enum_<AlignmentMethod>(m, "AlignmentMethod")
+      .value("UMEYAMA", AlignmentMethod::kUmeyama)
+      .value("UMEYAMA_ORIENTATION", AlignmentMethod::kUmeyamaOrientation)
+      .value("ORIENTATION", AlignmentMethod::kOrientation);
   nb::enum_<DeltaUnit>(m, "DeltaUnit").value("FRAMES", DeltaUnit::kFrames).value("METERS", DeltaUnit::kMeters);
 
   nb::class_<AssociationOptions>(m, "AssociationOptions")
@@ -74,6 +78,8 @@ void bind_options(nb::module_& m) {
       .def(nb::init<>())
       .def_rw("association", &EvalOptions::association)
       .def_rw("align_with_scale", &EvalOptions::align_with_scale)
+      .def_rw("min_spread_to_residual", &EvalOptions::min_spread_to_residual,
+              "below this spread across an axis (in RMS residuals) the rotation about it comes from the orientations")
       .def_rw("kitti", &EvalOptions::kitti)
       .def_rw("rpe", &EvalOptions::rpe)
       .def_rw("scan_stamps_ns", &EvalOptions::scan_stamps_ns, "coverage reference; empty: ground-truth stamps");
@@ -91,7 +97,8 @@ void bind_results(nb::module_& m) {
       .def_ro("transform", &Alignment::transform)
       .def_ro("scale", &Alignment::scale)
       .def_ro("rank_deficient", &Alignment::rank_deficient)
-      .def("__repr__", attribute_repr({"transform", "scale", "rank_deficient"}));
+      .def_ro("method", &Alignment::method)
+      .def("__repr__", attribute_repr({"method", "transform", "scale", "rank_deficient"}));
   nb::class_<ApeResult>(m, "ApeResult")
       .def_ro("alignment", &ApeResult::alignment)
       .def_ro("translation_m", &ApeResult::translation_m)

@@ -60,6 +60,9 @@ void bind_sim(nb::module_& m) {
       .def("num_scans", &SequenceGenerator::num_scans)
       .def("scan", &SequenceGenerator::scan, "i"_a, nb::call_guard<nb::gil_scoped_release>(),
            "Scan i (deterministic from seed and i; releases the GIL).")
+      .def("motion_compensated", &SequenceGenerator::motion_compensated, "scan"_a,
+           nb::call_guard<nb::gil_scoped_release>(),
+           "The scan as KITTI stores its scans: in the LiDAR frame at the scan end, no per-point times.")
       .def("imu", &SequenceGenerator::imu, nb::call_guard<nb::gil_scoped_release>(),
            "All IMU samples over the duration as a list of ImuSample.")
       .def(

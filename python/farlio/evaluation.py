@@ -67,6 +67,12 @@ def make_options(
     return o
 
 
+def alignment_method_name(method) -> str:
+    """'umeyama' (positions), 'umeyama_orientation' (positions on a line: the rotation about it from
+    the orientations) or 'orientation' (positions at one point), as eval.json states it."""
+    return method.name.lower()
+
+
 def _stats(s) -> dict[str, float]:
     return {"count": s.count, "rmse": s.rmse, "mean": s.mean, "median": s.median, "max": s.max}
 
@@ -86,6 +92,7 @@ def result_to_dict(r) -> dict[str, Any]:
             "translation_raw_m": _stats(r.ape.translation_raw_m),
             "rotation_raw_deg": _stats(r.ape.rotation_raw_deg),
             "alignment": {
+                "method": alignment_method_name(r.ape.alignment.method),
                 "matrix": r.ape.alignment.transform.matrix().tolist(),
                 "scale": r.ape.alignment.scale,
                 "rank_deficient": r.ape.alignment.rank_deficient,
@@ -240,8 +247,8 @@ def run_eval(args: argparse.Namespace) -> int:
         f"coverage {100 * summary['coverage']:.1f} %"
     )
     print(
-        f"APE aligned RMSE {ape['translation_m']['rmse']:.4f} m, raw {ape['translation_raw_m']['rmse']:.4f} m, "
-        f"rotation {ape['rotation_deg']['rmse']:.3f} deg"
+        f"APE aligned ({ape['alignment']['method']}) RMSE {ape['translation_m']['rmse']:.4f} m, "
+        f"raw {ape['translation_raw_m']['rmse']:.4f} m, rotation {ape['rotation_deg']['rmse']:.3f} deg"
     )
     print(
         f"KITTI RPE {kitti['translation_pct']:.3f} %, {kitti['rotation_deg_per_100m']:.4f} deg/100 m "

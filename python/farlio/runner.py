@@ -45,7 +45,6 @@ CONFIG_YAML, SUMMARY_JSON = "config.yaml", "summary.json"
 SCANS_LIDAR_TUM, SCANS_BODY_TUM, ODOMETRY_TUM = "scans_lidar.tum", "scans_body.tum", "odometry_body.tum"
 SCANS_LIDAR_KITTI = "scans_lidar_kitti.txt"
 MAP_PLY, MAP_PCD = "map.ply", "map.pcd"
-GROUNDTRUTH_SCANS_TUM = "groundtruth_scans.tum"
 EVAL_SCANS_DIR, EVAL_ODOMETRY_DIR = "eval_scans", "eval_odometry"
 MEDIAN_PERCENTILE, TAIL_PERCENTILE = 50, 99
 #: fewer registered poses than this are not evaluated
@@ -273,8 +272,8 @@ class OdometryRun:
         if len(self.lidar_poses) < MIN_EVALUATED_POSES:
             return
         gt_scans = groundtruth
-        if gt_scans is None and (Path(self.dataset.path) / GROUNDTRUTH_SCANS_TUM).exists():
-            gt_scans = Path(self.dataset.path) / GROUNDTRUTH_SCANS_TUM
+        if gt_scans is None:
+            gt_scans = self.dataset.groundtruth_scans_file()
         if gt_scans is None:
             gt_scans = self.dataset.groundtruth()  # a dense ground truth (MulRan): interpolated at the scan stamps
         if gt_scans is not None:

@@ -42,7 +42,8 @@ def write_sequence(
     on_scan: Callable[[int, int], None] | None = None,
 ) -> dict[str, Any]:
     """Generates and writes a sequence folder (lidar/, imu.csv, calib.yaml, ground truth, meta.yaml;
-    with kitti also velodyne/ + times.txt). Returns timing figures."""
+    with kitti also velodyne/ + times.txt: the scans motion-compensated to the scan end, stamped at
+    it, as KITTI odometry stores them). Returns timing figures."""
     gen = _core.sim.SequenceGenerator(config)
     w = _core.io.SequenceWriter(Path(out_dir))
     calib = _core.io.Calibration()
@@ -67,8 +68,8 @@ def write_sequence(
         gen_s += time.perf_counter() - t0
         points += len(scan)
         w.write_scan(scan, encoding)
-        if kitti:
-            w.write_kitti_scan(scan, i)
+        if kitti:  # KITTI's scans are motion-compensated to their stamp (the scan end here)
+            w.write_kitti_scan(gen.motion_compensated(scan), i)
         stamps.append(scan.end_stamp_ns)
         if on_scan:
             on_scan(i + 1, n)

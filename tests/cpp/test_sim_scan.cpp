@@ -1,4 +1,4 @@
-// LiDAR scans: exact motion distortion, sizes, per-point times, determinism.
+// LiDAR scans: exact motion distortion and its compensation, sizes, per-point times, determinism.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -65,6 +65,25 @@ TEST_P(SimScanProfile, DeDistortedPointsLieOnTheScene) {
   EXPECT_GT(checked, 100U);
   // Surfaces parallel to the motion hide the error, so only a share of points shows it.
   EXPECT_GT(off_with_end_pose, checked / 100) << "motion distortion should matter at these speeds";
+}
+
+TEST_P(SimScanProfile, MotionCompensatedPointsAreTheSameWorldPointsSeenFromTheScanEnd) {
+  const SequenceGenerator gen(short_config(GetParam(), false));
+  const Scan scan = gen.scan(moving_scan(GetParam()));
+  const Scan compensated = gen.motion_compensated(scan);
+  EXPECT_FALSE(compensated.has_time());
+  EXPECT_EQ(compensated.start_stamp_ns, scan.end_stamp_ns);
+  EXPECT_EQ(compensated.end_stamp_ns, scan.end_stamp_ns);
+  ASSERT_EQ(compensated.size(), scan.size());
+  EXPECT_EQ(compensated.intensity, scan.intensity);
+  const SE3 end_pose = lidar_pose_at(gen, scan, scan.duration_s());
+  std::size_t moved = 0;
+  for (std::size_t k = 0; k < scan.size(); k += kPointStride) {
+    const Eigen::Vector3d world = lidar_pose_at(gen, scan, scan.time_s[k]) * scan.points[k].cast<double>();
+    EXPECT_LT((end_pose * compensated.points[k].cast<double>() - world).norm(), kSurfaceTolerance_m) << k;
+    if ((compensated.points[k] - scan.points[k]).norm() > 10 * kSurfaceTolerance_m) ++moved;
+  }
+  EXPECT_GT(moved, 0U) << "the body moves during this scan";
 }
 
 TEST_P(SimScanProfile, TimesAndStampsAreConsistent) {

@@ -16,7 +16,9 @@ core = pytest.importorskip("farlio._core")
 import farlio  # noqa: E402
 from farlio._core import NS_PER_S  # noqa: E402
 from farlio.datasets import detect_format, open_dataset  # noqa: E402
+from farlio.datasets.folders import DEFAULT_PERIOD_NS  # noqa: E402
 from farlio.datasets.kitti_raw import EARTH_RADIUS_M, OXTS_COLUMNS, parse_kitti_stamp  # noqa: E402
+from farlio.evaluation import evaluate_files  # noqa: E402
 from farlio.runner import replay_options, run_dataset  # noqa: E402
 from farlio.simulation import make_config, write_sequence  # noqa: E402
 
@@ -31,6 +33,12 @@ OXTS_ACCEL, OXTS_GYRO = 11, 17  # first column of ax ay az and of wx wy wz
 ORIGIN_LAT_DEG, ORIGIN_LON_DEG, ORIGIN_ALT_M = 49.0, 8.4, 110.0
 #: OXTS positions go through degrees of latitude/longitude and back
 OXTS_POSE_TOLERANCE_M = 1e-6
+#: the KITTI-layout run: long enough to move (urban stands still for its first ~2 s); its APE
+#: against the KITTI ground truth, and the APE of the same poses one frame late
+KITTI_SIM_DURATION_S = 5.0
+KITTI_APE_MAX_M = 0.015
+KITTI_ROTATION_MAX_DEG = 1.0
+KITTI_LATE_APE_MIN_M = 0.03
 
 
 class WithoutTimes:
@@ -199,14 +207,45 @@ def test_mulran_missing_scan_files_are_reported(sequence, tmp_path):
 
 def test_kitti_odometry_times_convert_exactly(tmp_path):
     """times.txt seconds become exact integer ns, also for Unix times that a float64 cannot hold to
-    the nanosecond (the dataloader shifts them by one default period)."""
-    from farlio.datasets.folders import DEFAULT_PERIOD_NS
-
+    the nanosecond; scan k is stamped times.txt[k], start and end (a motion-compensated instant)."""
     times_s = ["1700000000.123456789", "1700000000.223456791"]
     (tmp_path / "velodyne").mkdir()
     for k in range(len(times_s)):
         core.io.write_kitti_bin(str(tmp_path / "velodyne" / f"{k:06d}.bin"), farlio.Scan(np.ones((4, 3), np.float32)))
     (tmp_path / "times.txt").write_text("\n".join(times_s) + "\n")
     ds = open_dataset(tmp_path, "kitti")
-    expected = [int(t.replace(".", "")) + DEFAULT_PERIOD_NS for t in times_s]
+    expected = [int(t.replace(".", "")) for t in times_s]
     assert [ds.scan(k).end_stamp_ns for k in range(len(times_s))] == expected
+    assert [ds.scan(k).start_stamp_ns for k in range(len(times_s))] == expected
+    assert ds.groundtruth() is None
+
+
+def test_kitti_layout_is_stamped_at_times_txt_and_evaluates_against_its_ground_truth(tmp_path):
+    """`farlio simulate --kitti` (velodyne/ motion-compensated to the scan end, times.txt,
+    groundtruth_kitti.txt) run as KITTI odometry: the scan poses carry the times.txt stamps and
+    match the KITTI ground truth by timestamp to cm level; one frame late they would not."""
+    seq = tmp_path / "urban"
+    write_sequence(make_config("urban", duration_s=KITTI_SIM_DURATION_S, seed=SIM_SEED), seq, kitti=True)
+    summary = run_dataset(
+        open_dataset(seq, "kitti"), tmp_path / "run", plot=False, progress=False, options=DETERMINISTIC
+    )
+    times_ns = list(core.io.read_stamps(seq / "times.txt"))
+    estimate = core.io.read_tum(tmp_path / "run" / "scans_lidar.tum")
+    assert [estimate[k][0] for k in range(len(estimate))] == times_ns
+
+    def ape(estimate_file: Path) -> dict:
+        return evaluate_files(estimate_file, seq / "groundtruth_kitti.txt", groundtruth_times=seq / "times.txt")["ape"]
+
+    on_time = ape(tmp_path / "run" / "scans_lidar.tum")
+    assert on_time["translation_m"]["rmse"] < KITTI_APE_MAX_M
+    assert on_time["rotation_deg"]["rmse"] < KITTI_ROTATION_MAX_DEG
+    # `farlio run` found the same ground truth (groundtruth_kitti.txt at the times.txt stamps)
+    assert summary["accuracy"]["associated_poses"] == len(times_ns)
+    assert summary["accuracy"]["ape"]["translation_m"]["rmse"] == pytest.approx(on_time["translation_m"]["rmse"])
+
+    late = farlio.Trajectory()
+    for k in range(len(estimate)):
+        stamp, pose = estimate[k]
+        late.push_back(stamp + DEFAULT_PERIOD_NS, pose)
+    core.io.write_tum(tmp_path / "late.tum", late)
+    assert ape(tmp_path / "late.tum")["translation_m"]["rmse"] > KITTI_LATE_APE_MIN_M

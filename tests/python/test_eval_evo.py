@@ -21,6 +21,12 @@ SCALE_DRIFT = 1.005
 KITTI_LENGTHS_M = [100.0 * k for k in range(1, 9)]
 KITTI_DEVKIT_STEP = 10
 KISS_ROTATION_REL_TOL = 5e-3
+#: the straight run: poses, spacing, per-pose position noise and RMS rotation error
+STRAIGHT_POSES = 300
+STRAIGHT_STEP_M = 0.5
+STRAIGHT_NOISE_M = 0.01
+STRAIGHT_ROTATION_ERROR_DEG = 0.1
+MAX_ALIGNED_ROTATION_DEG = 1.0
 
 
 def rot_z(a: float) -> np.ndarray:
@@ -226,3 +232,48 @@ def test_cli_writes_json_and_plot(files, tmp_path):
     summary = json.loads((out / "eval.json").read_text())
     assert summary["associated_poses"] == len(files["gt_poses"])
     assert (out / "eval.png").stat().st_size > 0
+
+
+def test_curved_run_is_aligned_by_umeyama(files):
+    ours = evaluation.evaluate_files(files["est"], files["gt"], plot=False)
+    assert ours["ape"]["alignment"]["method"] == "umeyama"
+
+
+def so3_exp(phi: np.ndarray) -> np.ndarray:
+    angle = np.linalg.norm(phi)
+    k = np.array([[0, -phi[2], phi[1]], [phi[2], 0, -phi[0]], [-phi[1], phi[0], 0]]) / angle
+    return np.eye(3) + np.sin(angle) * k + (1 - np.cos(angle)) * k @ k
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_straight_run_takes_the_rotation_about_the_line_from_the_orientations(tmp_path, capsys, seed):
+    """Positions on a line leave the rotation about it free (Umeyama's pick is arbitrary, up to
+    180 degrees off); eval.json names the alignment, and the aligned rotation error is the true one."""
+    from farlio import cli
+
+    rng = np.random.default_rng(seed)
+    gt = np.tile(np.eye(4), (STRAIGHT_POSES, 1, 1))
+    gt[:, 0, 3] = STRAIGHT_STEP_M * np.arange(STRAIGHT_POSES)
+    est = gt.copy()
+    sigma_rad = np.radians(STRAIGHT_ROTATION_ERROR_DEG) / np.sqrt(3.0)
+    true_sq = []
+    for p in est:
+        phi = rng.normal(0.0, sigma_rad, 3)
+        true_sq.append(np.dot(phi, phi))
+        p[:3, :3] = p[:3, :3] @ so3_exp(phi)
+    est[:, :3, 3] += rng.normal(0.0, STRAIGHT_NOISE_M, (STRAIGHT_POSES, 3))
+    offset = np.eye(4)
+    offset[:3, :3] = so3_exp(np.array([0.3, -1.1, 2.0]))
+    offset[:3, 3] = [4.0, -2.0, 7.0]
+    est = offset @ est
+    stamps = FIRST_STAMP_S + FRAME_PERIOD_S * np.arange(STRAIGHT_POSES)
+    out = tmp_path / "out"
+    gt_file, est_file = write_tum(tmp_path / "gt.tum", stamps, gt), write_tum(tmp_path / "est.tum", stamps, est)
+    assert cli.main(["eval", str(est_file), str(gt_file), "--out", str(out), "--no-plot"]) == 0
+    assert "APE aligned (umeyama_orientation)" in capsys.readouterr().out
+    ape = json.loads((out / "eval.json").read_text())["ape"]
+    assert ape["alignment"]["method"] == "umeyama_orientation"
+    assert ape["alignment"]["rank_deficient"]
+    true_rmse_deg = np.degrees(np.sqrt(np.mean(true_sq)))
+    assert ape["rotation_deg"]["rmse"] < MAX_ALIGNED_ROTATION_DEG
+    assert ape["rotation_deg"]["rmse"] == pytest.approx(true_rmse_deg, abs=0.05)

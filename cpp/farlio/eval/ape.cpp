@@ -26,7 +26,8 @@ PerPairErrors pair_errors(std::span<const SE3> estimate, std::span<const SE3> gr
 
 }  // namespace
 
-ApeResult compute_ape(std::span<const SE3> estimate, std::span<const SE3> groundtruth, bool align_with_scale) {
+ApeResult compute_ape(std::span<const SE3> estimate, std::span<const SE3> groundtruth, bool align_with_scale,
+                      double min_spread_to_residual) {
   if (estimate.size() != groundtruth.size()) {
     throw InputError("compute_ape: " + std::to_string(estimate.size()) + " estimate poses but " +
                      std::to_string(groundtruth.size()) + " ground-truth poses");
@@ -34,14 +35,7 @@ ApeResult compute_ape(std::span<const SE3> estimate, std::span<const SE3> ground
   ApeResult r;
   if (estimate.empty()) return r;
 
-  std::vector<Eigen::Vector3d> est_positions, gt_positions;
-  est_positions.reserve(estimate.size());
-  gt_positions.reserve(estimate.size());
-  for (std::size_t k = 0; k < estimate.size(); ++k) {
-    est_positions.push_back(estimate[k].translation());
-    gt_positions.push_back(groundtruth[k].translation());
-  }
-  r.alignment = umeyama_align(est_positions, gt_positions, align_with_scale);
+  r.alignment = align_poses(estimate, groundtruth, align_with_scale, min_spread_to_residual);
   r.aligned_estimate.reserve(estimate.size());
   for (const SE3& pose : estimate) r.aligned_estimate.push_back(r.alignment.apply(pose));
 

@@ -1,7 +1,8 @@
 #pragma once
 // Absolute pose error (APE / ATE) of associated pose pairs.
-//   aligned: estimate poses mapped by the Umeyama alignment of the estimate positions onto the
-//            ground-truth positions; raw: the estimate as given (same world frame assumed).
+//   aligned: estimate poses mapped by the alignment of the estimate onto the ground truth
+//            (align_poses: Umeyama on the positions, orientations where the positions leave the
+//            rotation free); raw: the estimate as given (same world frame assumed).
 //   translation error_k = | t(gt_k) - t(est_k) |            (metres)
 //   rotation error_k    = angle( R(gt_k)^T R(est_k) )        (degrees)
 #include <span>
@@ -25,6 +26,8 @@ struct ApeResult {
 };
 
 /// `estimate[k]` and `groundtruth[k]` are a pair; sizes must match (throws InputError otherwise).
-ApeResult compute_ape(std::span<const SE3> estimate, std::span<const SE3> groundtruth, bool align_with_scale = false);
+/// align_with_scale and min_spread_to_residual: as align_poses.
+ApeResult compute_ape(std::span<const SE3> estimate, std::span<const SE3> groundtruth, bool align_with_scale = false,
+                      double min_spread_to_residual = kDefaultMinSpreadToResidual);
 
 }  // namespace farlio::eval

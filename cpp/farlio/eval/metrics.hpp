@@ -19,6 +19,9 @@ inline constexpr std::size_t kMinAssociatedPoses = 3;
 struct EvalOptions {
   AssociationOptions association;
   bool align_with_scale = false;  ///< Sim(3) instead of SE(3) alignment for the aligned APE
+  /// below this spread of the positions across an axis, in RMS residuals of the position fit, the
+  /// rotation about it is taken from the orientations (align_poses)
+  double min_spread_to_residual = kDefaultMinSpreadToResidual;
   KittiRpeOptions kitti;
   DeltaRpeOptions rpe;
   /// Stamps of the scans the estimate should cover (coverage); empty: the ground-truth stamps.

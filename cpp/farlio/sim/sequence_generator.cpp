@@ -129,6 +129,30 @@ Scan SequenceGenerator::scan(std::size_t i) const {
   return out;
 }
 
+Scan SequenceGenerator::motion_compensated(const Scan& scan) const {
+  const auto T_world_lidar = [&](std::int64_t stamp_ns) {
+    return state(stamp_ns).pose_world_body * world_->T_imu_lidar;
+  };
+  const SE3 T_end_world = T_world_lidar(scan.end_stamp_ns).inverse();
+  Scan out;
+  out.start_stamp_ns = out.end_stamp_ns = scan.end_stamp_ns;
+  out.intensity = scan.intensity;
+  out.sensor_id = scan.sensor_id;
+  out.points.reserve(scan.size());
+  // the points of one firing share their time: one pose per run of equal times
+  SE3 T_end_point;
+  double pose_time_s = -1.0;  // the point time T_end_point is for (none yet)
+  for (std::size_t k = 0; k < scan.size(); ++k) {
+    const double t_s = scan.has_time() ? scan.time_s[k] : scan.duration_s();
+    if (t_s != pose_time_s) {
+      T_end_point = T_end_world * T_world_lidar(scan.start_stamp_ns + seconds_to_ns(t_s));
+      pose_time_s = t_s;
+    }
+    out.points.push_back((T_end_point * scan.points[k].cast<double>()).cast<float>());
+  }
+  return out;
+}
+
 std::vector<ImuSample> SequenceGenerator::imu() const { return generate_imu(*world_->motion, config_); }
 
 Trajectory SequenceGenerator::groundtruth_body(double rate_hz) const {

@@ -28,6 +28,9 @@ class SequenceGenerator {
   /// Deterministic from (seed, i): the same result in any call order; thread-safe. Rays of a
   /// scan are cast in parallel with TBB (the result does not depend on the thread count).
   [[nodiscard]] Scan scan(std::size_t i) const;
+  /// `scan` (one of scan(i)) as KITTI stores its scans: every point moved with the exact motion into
+  /// the LiDAR frame at the scan end, no per-point times, both stamps the end stamp.
+  [[nodiscard]] Scan motion_compensated(const Scan& scan) const;
   /// All samples over [0, duration], time-ordered, noisy unless noise_free.
   [[nodiscard]] std::vector<ImuSample> imu() const;
   /// The exact state of the body at stamp_ns.

@@ -38,7 +38,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         type=Path,
         default=None,
         help="ground-truth body poses (TUM) to evaluate against; a sequence folder's "
-        "groundtruth_scans.tum (MulRan: global_pose.csv) is used by default",
+        "groundtruth_scans.tum (MulRan: global_pose.csv; KITTI layout: groundtruth_kitti.txt) is used by default",
     )
     rec = parser.add_argument_group("recordings (bags, Ouster, calibration)")
     rec.add_argument(

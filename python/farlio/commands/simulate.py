@@ -29,7 +29,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--dropout", type=float, default=None, metavar="P", help="chance a ray returns nothing")
     parser.add_argument("--gyro-noise", type=float, default=None, metavar="RAD_S", help="gyro white noise std")
     parser.add_argument("--accel-noise", type=float, default=None, metavar="M_S2", help="accel white noise std")
-    parser.add_argument("--kitti", action="store_true", help="also write velodyne/*.bin + times.txt (KITTI layout)")
+    parser.add_argument(
+        "--kitti",
+        action="store_true",
+        help="also write the KITTI odometry layout: velodyne/*.bin (motion-compensated to the scan end) + times.txt",
+    )
     parser.add_argument(
         "--encoding",
         default="binary",

@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import farlio
+from farlio import _core
 
 from .pointcloud2 import TimeOptions
 
@@ -67,9 +69,22 @@ class Dataset:
         """True body poses at the scan end stamps, when the recording has them."""
         return None
 
+    def groundtruth_scans_file(self) -> Path | None:
+        """The TUM file groundtruth_scans() reads, when there is one (`farlio run` evaluates the
+        scan poses against it rather than against groundtruth())."""
+        return None
+
     def warnings(self) -> list[str]:
         return []
 
     @property
     def name(self) -> str:
         return Path(self.path).name
+
+
+def write_temporary_tum(trajectory: farlio.Trajectory, prefix: str) -> Path:
+    """A ground truth converted from a recording's own format, as groundtruth.tum in a new
+    temporary folder (what Dataset.groundtruth returns)."""
+    path = Path(tempfile.mkdtemp(prefix=prefix)) / "groundtruth.tum"
+    _core.io.write_tum(path, trajectory)
+    return path

@@ -7,9 +7,13 @@ from pathlib import Path
 import farlio
 from farlio import _core
 
-from .base import Dataset, LoadOptions
+from .base import Dataset, LoadOptions, write_temporary_tum
 
 POINT_CLOUD_SUFFIXES = (".pcd", ".pcd.gz", ".ply", ".bin")
+#: a sequence folder's body poses at the scan end stamps
+GROUNDTRUTH_SCANS_TUM = "groundtruth_scans.tum"
+#: LiDAR poses at the scan stamps relative to the first, KITTI 3x4 (`farlio simulate --kitti`)
+GROUNDTRUTH_KITTI = "groundtruth_kitti.txt"
 #: Scan period assumed for folders without stamps (10 Hz, the common spinning-LiDAR rate).
 DEFAULT_PERIOD_NS = 100_000_000
 
@@ -60,6 +64,10 @@ class SequenceFolder(Dataset):
     def groundtruth_scans(self) -> farlio.Trajectory | None:
         return self._reader.groundtruth_scans()
 
+    def groundtruth_scans_file(self) -> Path | None:
+        p = self.path / GROUNDTRUTH_SCANS_TUM
+        return p if p.exists() else None
+
     def warnings(self) -> list[str]:
         return list(self._reader.warnings())
 
@@ -82,8 +90,12 @@ class _FilesWithStamps(Dataset):
 
 
 class KittiOdometry(_FilesWithStamps):
-    """A KITTI odometry sequence: velodyne/NNNNNN.bin and times.txt (seconds); no per-point time
-    (KITTI scans are already undistorted)."""
+    """A KITTI odometry sequence: velodyne/NNNNNN.bin and times.txt (seconds). Scan k is stamped
+    times.txt[k], start and end alike: KITTI's scans are motion-compensated to that instant (no
+    per-point time), and its ground truth poses/XX.txt puts frame k there too. Without times.txt
+    scan k is at k * DEFAULT_PERIOD_NS, as read_kitti stamps poses without a times file.
+    Ground truth: groundtruth_kitti.txt (LiDAR poses, as `farlio simulate --kitti` writes them)
+    stamped by times.txt; KITTI's own poses/XX.txt are camera poses and are not read."""
 
     @classmethod
     def matches(cls, path: Path) -> bool:
@@ -96,13 +108,23 @@ class KittiOdometry(_FilesWithStamps):
             raise ValueError(f"{self.path / 'velodyne'}: no .bin scans")
         times = self.path / "times.txt"
         if times.exists():
-            stamps = _core.io.read_stamps(times)
-            if len(stamps) != len(self._files):
-                raise ValueError(f"{times}: {len(stamps)} stamps for {len(self._files)} scans in velodyne/")
-            # KITTI stamps can start at 0: shift so that the first scan has a positive start
-            self._stamps = [s + DEFAULT_PERIOD_NS for s in stamps]
+            self._stamps = list(_core.io.read_stamps(times))
+            if len(self._stamps) != len(self._files):
+                raise ValueError(f"{times}: {len(self._stamps)} stamps for {len(self._files)} scans in velodyne/")
         else:
-            self._stamps = [(i + 1) * DEFAULT_PERIOD_NS for i in range(len(self._files))]
+            self._stamps = [i * DEFAULT_PERIOD_NS for i in range(len(self._files))]
+        self._gt: Path | None = None
+
+    def scan(self, i: int) -> farlio.Scan:
+        return _with_stamps(_core.io.read_point_cloud(self._files[i]), self._stamps[i], self._stamps[i])
+
+    def groundtruth(self) -> Path | None:
+        src = self.path / GROUNDTRUTH_KITTI
+        if not src.exists():
+            return None
+        if self._gt is None:  # one pose a scan (InputError otherwise)
+            self._gt = write_temporary_tum(_core.io.read_kitti(src, self._stamps), "farlio-kitti-")
+        return self._gt
 
 
 class PointCloudFolder(_FilesWithStamps):

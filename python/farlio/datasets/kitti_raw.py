@@ -14,17 +14,15 @@ rotation Rz(yaw) Ry(pitch) Rx(roll), relative to the first pose (a TUM file in a
 from __future__ import annotations
 
 import math
-import tempfile
 from datetime import datetime, timezone
 from pathlib import Path
 
 import numpy as np
 
 import farlio
-from farlio import _core
 from farlio._core import NS_PER_S
 
-from .base import LoadOptions
+from .base import LoadOptions, write_temporary_tum
 from .calib import CalibFile, se3_from_matrix
 from .folders import DEFAULT_PERIOD_NS, _FilesWithStamps
 
@@ -196,8 +194,7 @@ class KittiRaw(_FilesWithStamps):
             traj = farlio.Trajectory()
             for stamp, p in zip(self._oxts_stamps, self._oxts_poses):
                 traj.push_back(stamp, farlio.SE3.from_matrix(first_inv @ oxts_pose(p, scale)))
-            self._gt = Path(tempfile.mkdtemp(prefix="farlio-kitti-raw-")) / "groundtruth.tum"
-            _core.io.write_tum(self._gt, traj)
+            self._gt = write_temporary_tum(traj, "farlio-kitti-raw-")
         return self._gt
 
     def T_imu_lidar(self) -> farlio.SE3:

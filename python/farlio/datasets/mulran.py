@@ -9,15 +9,13 @@ IMU is used only with --calib (its extrinsic to the Ouster is not in the recordi
 
 from __future__ import annotations
 
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
 import farlio
-from farlio import _core
 
-from .base import LoadOptions
+from .base import LoadOptions, write_temporary_tum
 from .calib import CalibFile
 from .folders import _FilesWithStamps
 
@@ -123,8 +121,7 @@ class MulRan(_FilesWithStamps):
                 m = np.eye(4)
                 m[:3, :] = r.reshape(3, 4)
                 traj.push_back(stamp, farlio.SE3.from_matrix(m))
-            self._gt = Path(tempfile.mkdtemp(prefix="farlio-mulran-")) / "groundtruth.tum"
-            _core.io.write_tum(self._gt, traj)
+            self._gt = write_temporary_tum(traj, "farlio-mulran-")
         return self._gt
 
     def warnings(self) -> list[str]:
