@@ -3,7 +3,7 @@
 // median / p99 / max per frame, the device-timed stages, device memory, and the pose agreement
 // with the CPU backend on the same scans; then the effective bandwidth of the k-NN and the GICP
 // reduction against a device-to-device copy. Run by scripts/gpu_check.sh.
-// Usage: gpu_pipeline [--frames N] [--profile urban|racetrack|handheld]... [--device cuda|cpu|auto]
+// Usage: gpu_pipeline [--frames N] [--profile urban|racetrack|handheld|tunnel]... [--device cuda|cpu|auto]
 //                     [--no-cpu-compare] [--repeats R]
 #include <algorithm>
 #include <chrono>

@@ -39,8 +39,8 @@ int main(int argc, char** argv) {
   const std::size_t scans = argc > 1 ? std::strtoul(argv[1], nullptr, 10) : kDefaultScans;
   std::printf("%-10s %12s %14s %14s %14s %12s\n", "profile", "points/scan", "1 core ms", "1 core max ms",
               "all cores ms", "threads");
-  for (const auto profile :
-       {farlio::sim::Profile::Racetrack, farlio::sim::Profile::Urban, farlio::sim::Profile::Handheld}) {
+  for (const auto profile : {farlio::sim::Profile::Racetrack, farlio::sim::Profile::Urban,
+                             farlio::sim::Profile::Handheld, farlio::sim::Profile::Tunnel}) {
     farlio::sim::SimConfig cfg = farlio::sim::default_config(profile);
     const farlio::sim::SequenceGenerator gen(cfg);
     Timing one;

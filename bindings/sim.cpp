@@ -19,8 +19,9 @@ void bind_sim(nb::module_& m) {
   nb::enum_<Profile>(m, "Profile")
       .value("Racetrack", Profile::Racetrack)
       .value("Urban", Profile::Urban)
-      .value("Handheld", Profile::Handheld);
-  m.def("parse_profile", &parse_profile, "name"_a, "'racetrack' | 'urban' | 'handheld'.");
+      .value("Handheld", Profile::Handheld)
+      .value("Tunnel", Profile::Tunnel);
+  m.def("parse_profile", &parse_profile, "name"_a, "'racetrack' | 'urban' | 'handheld' | 'tunnel'.");
   m.def("profile_name", &profile_name, "profile"_a);
 
   nb::class_<NoiseConfig>(m, "NoiseConfig", "LiDAR and IMU noise of a simulated sequence.")

@@ -9,6 +9,8 @@ from typing import Any, Callable
 import farlio
 from farlio import _core
 
+#: the generator's profiles (docs/simulation.md)
+PROFILES = ("racetrack", "urban", "handheld", "tunnel")
 #: rate of groundtruth.tum (body poses); the scan-end poses are in groundtruth_scans.tum
 GROUNDTRUTH_RATE_HZ = 100.0
 
@@ -85,4 +87,4 @@ def generate(profile: str, out_dir: Path, **kwargs: Any) -> dict[str, Any]:
     return write_sequence(cfg, out_dir, **{k: v for k, v in kwargs.items() if k in write_keys})
 
 
-__all__ = ["GROUNDTRUTH_RATE_HZ", "generate", "make_config", "write_sequence", "farlio"]
+__all__ = ["GROUNDTRUTH_RATE_HZ", "PROFILES", "generate", "make_config", "write_sequence", "farlio"]

@@ -108,9 +108,10 @@ TEST(SimImu, RacetrackNoiseFreeIntegratesToTruth) {
 
 TEST(SimImu, UrbanNoiseFreeIntegratesToTruth) { check_profile(Profile::Urban, 60.0); }
 TEST(SimImu, HandheldNoiseFreeIntegratesToTruth) { check_profile(Profile::Handheld, 40.0); }
+TEST(SimImu, TunnelNoiseFreeIntegratesToTruth) { check_profile(Profile::Tunnel, 40.0); }
 
 TEST(SimImu, AtRestReadsGravityUp) {
-  for (const Profile p : {Profile::Urban, Profile::Racetrack}) {  // both start standing still
+  for (const Profile p : {Profile::Urban, Profile::Racetrack, Profile::Tunnel}) {  // all start standing still
     SimConfig cfg = default_config(p);
     cfg.noise_free = true;
     cfg.duration_s = 1.0;

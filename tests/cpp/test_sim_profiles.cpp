@@ -118,25 +118,61 @@ TEST(SimProfiles, HandheldWalksAndTurnsQuickly) {
   EXPECT_LT(e.z_max_m - e.z_min_m, 0.1);
 }
 
-TEST(SimProfiles, GroundTruthTrajectories) {
-  SimConfig cfg = default_config(Profile::Urban);
-  cfg.duration_s = 3.0;
+TEST(SimProfiles, TunnelDrivesStraightThroughTheTunnel) {
+  const SimConfig cfg = default_config(Profile::Tunnel);
   const SequenceGenerator gen(cfg);
-  const Trajectory body = gen.groundtruth_body(100.0);
-  EXPECT_EQ(body.size(), 301U);
-  EXPECT_TRUE(body.is_time_ordered());
-  const Trajectory scans = gen.groundtruth_scans();
-  ASSERT_EQ(scans.size(), gen.num_scans());
-  EXPECT_EQ(gen.num_scans(), 30U);
-  for (std::size_t i = 0; i < scans.size(); ++i) {
-    EXPECT_EQ(scans[i].stamp_ns, gen.scan_start_ns(i) + gen.scan_period_ns());
-    EXPECT_LT((scans[i].pose.translation() - gen.state(scans[i].stamp_ns).pose_world_body.translation()).norm(), 1e-12);
+  const auto fact = [&](const char* key) { return std::stod(gen.description().at(key)); };
+  const auto state_at = [&](double t) { return gen.state(cfg.start_stamp_ns + std::llround(t * 1e9)); };
+  const Extremes e = sample(gen, cfg.duration_s);
+  // 0 -> 100 km/h after 2 s at rest, straight and level: no rotation, no height change.
+  EXPECT_GT(e.max_speed_m_s, 27.7);
+  EXPECT_LE(e.max_speed_m_s, 100.0 / 3.6 + 1e-6);
+  EXPECT_NEAR(e.standstill_s, 2.0, 0.05);
+  EXPECT_LT(e.max_rate_rad_s, 1e-9);
+  EXPECT_LT(e.z_max_m - e.z_min_m, 1e-9);
+  EXPECT_LT(e.max_lateral_m_s2, 1e-9);
+  for (double t = 0.0; t <= cfg.duration_s; t += 1.0) {
+    const Eigen::Vector3d p = state_at(t).pose_world_body.translation();
+    EXPECT_LT(std::abs(p.y()), 1e-9) << "on the tunnel's centre line at " << t;
+  }
+  // The featureless section: several hundred metres inside the tunnel, driven at cruise speed,
+  // and its bounds in time and x agree with the motion.
+  const double x0 = fact("featureless_start_x_m"), x1 = fact("featureless_end_x_m");
+  const double t0 = fact("featureless_start_s"), t1 = fact("featureless_end_s");
+  EXPECT_GT(x0, fact("tunnel_start_x_m"));
+  EXPECT_LT(x1, fact("tunnel_end_x_m"));
+  EXPECT_GE(x1 - x0, 500.0);
+  EXPECT_GT(t0, 0.0);
+  EXPECT_LT(t1, cfg.duration_s);
+  EXPECT_NEAR(state_at(t0).pose_world_body.translation().x(), x0, 1e-3);
+  EXPECT_NEAR(state_at(t1).pose_world_body.translation().x(), x1, 1e-3);
+  EXPECT_GT(state_at(t0).velocity_world_m_s.norm(), 25.0);
+  // The default duration ends outside, after the exit portal.
+  EXPECT_GT(state_at(cfg.duration_s).pose_world_body.translation().x(), fact("tunnel_end_x_m"));
+}
+
+TEST(SimProfiles, GroundTruthTrajectories) {
+  for (const Profile p : {Profile::Racetrack, Profile::Urban, Profile::Handheld, Profile::Tunnel}) {
+    SimConfig cfg = default_config(p);
+    cfg.duration_s = 3.0;
+    const SequenceGenerator gen(cfg);
+    const Trajectory body = gen.groundtruth_body(100.0);
+    EXPECT_EQ(body.size(), 301U) << profile_name(p);
+    EXPECT_TRUE(body.is_time_ordered());
+    const Trajectory scans = gen.groundtruth_scans();
+    ASSERT_EQ(scans.size(), gen.num_scans());
+    EXPECT_EQ(gen.num_scans(), static_cast<std::size_t>(std::llround(3.0 * cfg.lidar_rate_hz))) << profile_name(p);
+    for (std::size_t i = 0; i < scans.size(); ++i) {
+      EXPECT_EQ(scans[i].stamp_ns, gen.scan_start_ns(i) + gen.scan_period_ns());
+      EXPECT_LT((scans[i].pose.translation() - gen.state(scans[i].stamp_ns).pose_world_body.translation()).norm(),
+                1e-12);
+    }
   }
 }
 
 TEST(SimProfiles, VelocityIsTheDerivativeOfPosition) {
   // Central differences of the exact poses agree with the analytic velocity and rate.
-  for (const Profile p : {Profile::Racetrack, Profile::Urban, Profile::Handheld}) {
+  for (const Profile p : {Profile::Racetrack, Profile::Urban, Profile::Handheld, Profile::Tunnel}) {
     const SequenceGenerator gen(default_config(p));
     constexpr std::int64_t kStep_ns = 1'000'000;
     for (const double t : {0.3, 3.7, 11.1, 25.9, 47.3}) {
@@ -158,14 +194,16 @@ TEST(SimConfigApi, ParseProfile) {
   EXPECT_EQ(parse_profile("racetrack"), Profile::Racetrack);
   EXPECT_EQ(parse_profile("urban"), Profile::Urban);
   EXPECT_EQ(parse_profile("handheld"), Profile::Handheld);
+  EXPECT_EQ(parse_profile("tunnel"), Profile::Tunnel);
   try {
     (void)parse_profile("moon");
     FAIL() << "expected an error";
   } catch (const std::invalid_argument& e) {
     const std::string msg = e.what();
-    for (const char* name : {"moon", "racetrack", "urban", "handheld"}) EXPECT_NE(msg.find(name), std::string::npos);
+    for (const char* name : {"moon", "racetrack", "urban", "handheld", "tunnel"})
+      EXPECT_NE(msg.find(name), std::string::npos);
   }
-  for (const Profile p : {Profile::Racetrack, Profile::Urban, Profile::Handheld})
+  for (const Profile p : {Profile::Racetrack, Profile::Urban, Profile::Handheld, Profile::Tunnel})
     EXPECT_EQ(parse_profile(profile_name(p)), p);
 }
 
@@ -180,4 +218,11 @@ TEST(SimConfigApi, DefaultsDifferPerProfile) {
   EXPECT_GT(race.noise.accel_noise_std_m_s2, urban.noise.accel_noise_std_m_s2);
   EXPECT_GT(race.noise.gyro_noise_std_rad_s, urban.noise.gyro_noise_std_rad_s);
   EXPECT_FALSE(race.noise_free);
+  // The tunnel car carries the urban car's sensors.
+  const SimConfig tunnel = default_config(Profile::Tunnel);
+  EXPECT_EQ(tunnel.duration_s, 45.0);
+  EXPECT_EQ(tunnel.lidar_rate_hz, urban.lidar_rate_hz);
+  EXPECT_EQ(tunnel.imu_rate_hz, urban.imu_rate_hz);
+  EXPECT_EQ(tunnel.noise.accel_noise_std_m_s2, urban.noise.accel_noise_std_m_s2);
+  EXPECT_EQ(tunnel.noise.accel_bias_initial_m_s2, urban.noise.accel_bias_initial_m_s2);
 }

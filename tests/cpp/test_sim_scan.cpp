@@ -18,6 +18,7 @@ std::size_t moving_scan(Profile p) {
     case Profile::Racetrack: return 200;  // 10 s: near top speed at the end of the standing start
     case Profile::Urban: return 100;
     case Profile::Handheld: return 40;
+    case Profile::Tunnel: return 100;  // 10 s: ~16 m/s, approaching the tunnel portal
   }
   return 0;
 }
@@ -127,7 +128,7 @@ TEST_P(SimScanProfile, SameSeedBitIdenticalInAnyOrderOtherSeedDiffers) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Profiles, SimScanProfile,
-                         ::testing::Values(Profile::Racetrack, Profile::Urban, Profile::Handheld),
+                         ::testing::Values(Profile::Racetrack, Profile::Urban, Profile::Handheld, Profile::Tunnel),
                          [](const ::testing::TestParamInfo<Profile>& param_info) {
                            return profile_name(param_info.param);
                          });

@@ -76,3 +76,22 @@ def test_determinism_and_threads():
     assert not np.array_equal(results[5], np.asarray(sim.SequenceGenerator(cfg).scan(5).points))
     desc = gen.description()
     assert desc["profile"] == "urban" and desc["seed"] == "1"
+
+
+def test_tunnel_meta_has_the_featureless_section(tmp_path):
+    # meta.yaml of a generated tunnel sequence carries the featureless section's bounds, as numbers,
+    # consistent with the exact motion (evaluation scripts read them).
+    import yaml
+    from farlio.simulation import generate
+
+    generate("tunnel", tmp_path, duration_s=0.2)
+    meta = yaml.safe_load((tmp_path / "meta.yaml").read_text())
+    assert meta["profile"] == "tunnel"
+    x0, x1 = float(meta["featureless_start_x_m"]), float(meta["featureless_end_x_m"])
+    t0, t1 = float(meta["featureless_start_s"]), float(meta["featureless_end_s"])
+    assert x1 - x0 >= 500.0 and 0.0 < t0 < t1 < sim.default_config("tunnel").duration_s
+    gen = sim.SequenceGenerator(sim.default_config("tunnel"))
+    start = int(meta["start_stamp_ns"])
+    for t, x in ((t0, x0), (t1, x1)):
+        pose = gen.state(start + round(t * core.NS_PER_S)).pose_world_body
+        assert pose.translation[0] == pytest.approx(x, abs=1e-3)

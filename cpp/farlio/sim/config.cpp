@@ -12,16 +12,20 @@ struct ProfileDefaults {
   NoiseConfig noise;
 };
 
+/// The urban car's LiDAR and IMU noise (urban and tunnel).
+NoiseConfig car_noise() {
+  return NoiseConfig{
+      0.02, 0.01, 0.003, 0.05, 2e-5, 3e-4, Eigen::Vector3d(0.001, -0.0015, 0.0008), Eigen::Vector3d(0.04, 0.03, -0.05)};
+}
+
 ProfileDefaults defaults_of(Profile p) {
   switch (p) {
     case Profile::Racetrack:      // engine and kerb vibration: high IMU noise
       return {85.0, 20.0, 800.0,  // 2 s rest, standing start and one lap take 82.7 s
               NoiseConfig{0.02, 0.02, 0.02, 0.5, 2e-4, 2e-3, Eigen::Vector3d(0.003, -0.002, 0.001),
                           Eigen::Vector3d(0.08, -0.05, 0.06)}};
-    case Profile::Urban:
-      return {120.0, 10.0, 100.0,
-              NoiseConfig{0.02, 0.01, 0.003, 0.05, 2e-5, 3e-4, Eigen::Vector3d(0.001, -0.0015, 0.0008),
-                          Eigen::Vector3d(0.04, 0.03, -0.05)}};
+    case Profile::Urban: return {120.0, 10.0, 100.0, car_noise()};
+    case Profile::Tunnel: return {45.0, 10.0, 100.0, car_noise()};  // the urban car's sensors
     case Profile::Handheld:
       return {90.0, 10.0, 200.0,
               NoiseConfig{0.01, 0.01, 0.005, 0.08, 4e-5, 6e-4, Eigen::Vector3d(-0.002, 0.001, 0.0015),
@@ -35,7 +39,8 @@ Profile parse_profile(const std::string& name) {
   if (name == "racetrack") return Profile::Racetrack;
   if (name == "urban") return Profile::Urban;
   if (name == "handheld") return Profile::Handheld;
-  throw std::invalid_argument("unknown simulation profile '" + name + "' (valid: racetrack, urban, handheld)");
+  if (name == "tunnel") return Profile::Tunnel;
+  throw std::invalid_argument("unknown simulation profile '" + name + "' (valid: racetrack, urban, handheld, tunnel)");
 }
 
 std::string profile_name(Profile profile) {
@@ -43,6 +48,7 @@ std::string profile_name(Profile profile) {
     case Profile::Racetrack: return "racetrack";
     case Profile::Urban: return "urban";
     case Profile::Handheld: return "handheld";
+    case Profile::Tunnel: return "tunnel";
   }
   throw std::invalid_argument("unknown profile");
 }

@@ -179,6 +179,7 @@ std::map<std::string, std::string> SequenceGenerator::description() const {
   std::map<std::string, std::string> d = world_->facts;
   d["profile"] = profile_name(config_.profile);
   d["seed"] = std::to_string(config_.seed);
+  d["start_stamp_ns"] = std::to_string(config_.start_stamp_ns);  // t = 0 of the times in seconds
   d["duration_s"] = num(config_.duration_s);
   d["noise_free"] = config_.noise_free ? "true" : "false";
   d["lidar_rate_hz"] = num(config_.lidar_rate_hz);

@@ -1,6 +1,6 @@
 // The urban profile: a grid of city blocks on hilly ground (the height varies along x), with
 // buildings, parked cars, poles and trees; a car drives a route of straights and right-angle
-// turns with full stops; one 64-beam spinning LiDAR.
+// turns with full stops; one 64-beam spinning LiDAR (mount_car_lidar, shared with the tunnel).
 #include <cmath>
 #include <numbers>
 
@@ -147,13 +147,17 @@ World build_urban_world() {
   w.scene.build_index(kGridCell_m);
 
   w.facts["route_length_m"] = std::to_string(path.length_m());
-  w.facts["lidar"] = "64-beam spinning LiDAR, -24.9..+2 deg, 1875 azimuth steps";
   w.motion = std::make_shared<VehicleMotion>(std::move(path), std::move(plan), terrain(), kBodyHeight_m);
+  mount_car_lidar(w);
+  return w;
+}
+
+void mount_car_lidar(World& w) {
+  w.facts["lidar"] = "64-beam spinning LiDAR, -24.9..+2 deg, 1875 azimuth steps";
   w.T_imu_lidar = mount_pose({0.3, 0.0, 1.2}, -0.015, 0.01, 0.008);
   w.lidars.push_back(spinning_lidar(0, SE3::identity(),
                                     uniform_elevations_rad(kChannels, kLowestElevation_rad, kHighestElevation_rad),
                                     kColumns, kMinRange_m, kMaxRange_m));
-  return w;
 }
 
 }  // namespace farlio::sim

@@ -9,6 +9,7 @@ World build_world(Profile profile) {
     case Profile::Racetrack: return build_racetrack_world();
     case Profile::Urban: return build_urban_world();
     case Profile::Handheld: return build_handheld_world();
+    case Profile::Tunnel: return build_tunnel_world();
   }
   throw std::invalid_argument("unknown profile");
 }

@@ -27,6 +27,11 @@ World build_world(Profile profile);
 World build_racetrack_world();
 World build_urban_world();
 World build_handheld_world();
+World build_tunnel_world();
+
+/// The urban car's roof LiDAR (one 64-beam spinning sensor) and its extrinsic, into w (urban
+/// and tunnel).
+void mount_car_lidar(World& w);
 
 /// A small fixed rotation plus offset, used for the LiDAR extrinsics.
 SE3 mount_pose(const Eigen::Vector3d& offset_m, double yaw_rad, double pitch_rad, double roll_rad);

@@ -9,13 +9,14 @@ from pathlib import Path
 from farlio.benchmark import compare, format_table, generated_scans
 from farlio.datasets import open_dataset
 from farlio.runner import DEVICES
+from farlio.simulation import PROFILES
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--profile",
         action="append",
-        choices=["urban", "racetrack", "handheld"],
+        choices=PROFILES,
         help="generated scans of this profile (repeatable; default: urban)",
     )
     parser.add_argument("--scans", type=int, default=100, help="frames per data set")

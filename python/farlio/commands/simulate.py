@@ -6,9 +6,7 @@ import argparse
 from pathlib import Path
 
 from farlio.progress import Progress
-from farlio.simulation import make_config, write_sequence
-
-PROFILES = ("racetrack", "urban", "handheld")
+from farlio.simulation import PROFILES, make_config, write_sequence
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -17,7 +15,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         choices=PROFILES,
         help="racetrack: 3 LiDARs at 20 Hz, up to 70 m/s, 800 Hz IMU; urban: 64-beam LiDAR at "
         "10 Hz, 8-15 m/s, 100 Hz IMU; handheld: 32-beam LiDAR at 10 Hz, rooms and corridors, "
-        "200 Hz IMU (docs/simulation.md)",
+        "200 Hz IMU; tunnel: the urban car's sensors, 0 -> 100 km/h through an 850 m tunnel whose bare "
+        "middle is degenerate along the track (docs/simulation.md)",
     )
     parser.add_argument("--out", type=Path, required=True, help="output sequence folder (created)")
     parser.add_argument("--seed", type=int, default=1, help="noise seed (the scene and trajectory are fixed)")
