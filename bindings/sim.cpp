@@ -6,6 +6,8 @@
 #include <nanobind/stl/vector.h>
 
 #include "bindings.hpp"
+#include "farlio/sim/imu_errors.hpp"
+#include "farlio/sim/imu_grade.hpp"
 #include "farlio/sim/sequence_generator.hpp"
 
 namespace nb = nanobind;
@@ -35,12 +37,53 @@ void bind_sim(nb::module_& m) {
       .def_rw("gyro_bias_initial_rad_s", &NoiseConfig::gyro_bias_initial_rad_s)
       .def_rw("accel_bias_initial_m_s2", &NoiseConfig::accel_bias_initial_m_s2);
 
+  nb::class_<VibrationConfig>(m, "VibrationConfig",
+                              "Mount vibration growing with speed: wheel-order sinusoid + broadband noise.")
+      .def(nb::init<>())
+      .def_rw("wheel_radius_m", &VibrationConfig::wheel_radius_m)
+      .def_rw("accel_wheel_amplitude_m_s2_per_m_s", &VibrationConfig::accel_wheel_amplitude_m_s2_per_m_s)
+      .def_rw("gyro_wheel_amplitude_rad_s_per_m_s", &VibrationConfig::gyro_wheel_amplitude_rad_s_per_m_s)
+      .def_rw("accel_noise_std_m_s2_per_m_s", &VibrationConfig::accel_noise_std_m_s2_per_m_s)
+      .def_rw("gyro_noise_std_rad_s_per_m_s", &VibrationConfig::gyro_noise_std_rad_s_per_m_s)
+      .def("any", &VibrationConfig::any);
+
+  nb::class_<ImuErrorConfig>(m, "ImuErrorConfig",
+                             "Turn-on bias, scale factor, misalignment, g-sensitivity and vibration of the IMU.")
+      .def(nb::init<>())
+      .def_rw("gyro_turn_on_bias_std_rad_s", &ImuErrorConfig::gyro_turn_on_bias_std_rad_s)
+      .def_rw("accel_turn_on_bias_std_m_s2", &ImuErrorConfig::accel_turn_on_bias_std_m_s2)
+      .def_rw("gyro_scale_factor_std_ppm", &ImuErrorConfig::gyro_scale_factor_std_ppm)
+      .def_rw("accel_scale_factor_std_ppm", &ImuErrorConfig::accel_scale_factor_std_ppm)
+      .def_rw("gyro_misalignment_std_mrad", &ImuErrorConfig::gyro_misalignment_std_mrad)
+      .def_rw("accel_misalignment_std_mrad", &ImuErrorConfig::accel_misalignment_std_mrad)
+      .def_rw("gyro_g_sensitivity_std_rad_s_per_m_s2", &ImuErrorConfig::gyro_g_sensitivity_std_rad_s_per_m_s2)
+      .def_rw("vibration", &ImuErrorConfig::vibration)
+      .def("any", &ImuErrorConfig::any);
+
+  nb::class_<ImuErrorDraw>(m, "ImuErrorDraw", "The IMU error constants of one run, drawn from the seed.")
+      .def_ro("gyro_turn_on_bias_rad_s", &ImuErrorDraw::gyro_turn_on_bias_rad_s)
+      .def_ro("accel_turn_on_bias_m_s2", &ImuErrorDraw::accel_turn_on_bias_m_s2)
+      .def_ro("gyro_response", &ImuErrorDraw::gyro_response)
+      .def_ro("accel_response", &ImuErrorDraw::accel_response)
+      .def_ro("gyro_g_sensitivity_rad_s_per_m_s2", &ImuErrorDraw::gyro_g_sensitivity_rad_s_per_m_s2);
+  m.def("draw_imu_errors", &draw_imu_errors, "config"_a, "seed"_a, "The error constants of a run (ImuErrorDraw).");
+
+  nb::enum_<ImuGrade>(m, "ImuGrade")
+      .value("Profile", ImuGrade::Profile)
+      .value("Ideal", ImuGrade::Ideal)
+      .value("Consumer", ImuGrade::Consumer)
+      .value("Industrial", ImuGrade::Industrial)
+      .value("Tactical", ImuGrade::Tactical);
+  m.def("parse_imu_grade", &parse_imu_grade, "name"_a, "'profile' | 'ideal' | 'consumer' | 'industrial' | 'tactical'.");
+  m.def("imu_grade_name", &imu_grade_name, "grade"_a);
+
   nb::class_<SimConfig>(m, "SimConfig", "Profile, seed, duration, noise and rates; see default_config().")
       .def(nb::init<>())
       .def_rw("profile", &SimConfig::profile)
       .def_rw("seed", &SimConfig::seed)
       .def_rw("duration_s", &SimConfig::duration_s)
       .def_rw("noise", &SimConfig::noise)
+      .def_rw("imu_errors", &SimConfig::imu_errors)
       .def_rw("noise_free", &SimConfig::noise_free)
       .def_rw("start_stamp_ns", &SimConfig::start_stamp_ns)
       .def_rw("lidar_rate_hz", &SimConfig::lidar_rate_hz)
@@ -49,6 +92,15 @@ void bind_sim(nb::module_& m) {
   m.def("default_config", &default_config, "profile"_a, "The documented defaults of a profile.");
   m.def(
       "default_config", [](const std::string& name) { return default_config(parse_profile(name)); }, "profile"_a);
+  m.def(
+      "apply_imu_grade",
+      [](SimConfig config, const std::string& grade, bool vibration) {
+        apply_imu_grade(config, parse_imu_grade(grade), vibration);
+        return config;
+      },
+      "config"_a, "grade"_a, "vibration"_a = true,
+      "A copy of config with the IMU set to a grade (profile: unchanged; ideal: no IMU error; consumer, industrial, "
+      "tactical: datasheet classes plus the profile's vibration unless vibration=False).");
 
   nb::class_<BodyState>(m, "BodyState", "Exact state of the body (IMU) frame.")
       .def_ro("pose_world_body", &BodyState::pose_world_body)

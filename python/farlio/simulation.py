@@ -14,16 +14,29 @@ PROFILES = ("racetrack", "urban", "handheld", "tunnel")
 #: rate of groundtruth.tum (body poses); the scan-end poses are in groundtruth_scans.tum
 GROUNDTRUTH_RATE_HZ = 100.0
 
+#: IMU grades (docs/simulation.md): the profile's own IMU noise (default), an ideal IMU, datasheet classes
+IMU_GRADES = ("profile", "ideal", "consumer", "industrial", "tactical")
+
 
 def make_config(
-    profile: str, *, seed: int = 1, duration_s: float | None = None, noise_free: bool = False, **noise: float
+    profile: str,
+    *,
+    seed: int = 1,
+    duration_s: float | None = None,
+    noise_free: bool = False,
+    imu_grade: str = "profile",
+    vibration: bool = True,
+    **noise: float,
 ) -> Any:
-    """The profile's defaults with the given overrides (noise fields by their NoiseConfig name)."""
+    """The profile's defaults with the given overrides: the IMU set to imu_grade (with the platform
+    vibration of the datasheet grades unless vibration=False), then the noise fields by their
+    NoiseConfig name."""
     cfg = _core.sim.default_config(profile)
     cfg.seed = seed
     if duration_s is not None:
         cfg.duration_s = duration_s
     cfg.noise_free = noise_free
+    cfg = _core.sim.apply_imu_grade(cfg, imu_grade, vibration)
     n = cfg.noise
     for name, value in noise.items():
         if value is None:
@@ -87,4 +100,4 @@ def generate(profile: str, out_dir: Path, **kwargs: Any) -> dict[str, Any]:
     return write_sequence(cfg, out_dir, **{k: v for k, v in kwargs.items() if k in write_keys})
 
 
-__all__ = ["GROUNDTRUTH_RATE_HZ", "PROFILES", "generate", "make_config", "write_sequence", "farlio"]
+__all__ = ["GROUNDTRUTH_RATE_HZ", "IMU_GRADES", "PROFILES", "generate", "make_config", "write_sequence", "farlio"]

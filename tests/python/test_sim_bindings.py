@@ -95,3 +95,50 @@ def test_tunnel_meta_has_the_featureless_section(tmp_path):
     for t, x in ((t0, x0), (t1, x1)):
         pose = gen.state(start + round(t * core.NS_PER_S)).pose_world_body
         assert pose.translation[0] == pytest.approx(x, abs=1e-3)
+
+
+def test_imu_grades_through_make_config():
+    from farlio.simulation import IMU_GRADES, make_config
+
+    assert IMU_GRADES[0] == "profile"
+    default = sim.default_config("urban")
+    cfg = make_config("urban", imu_grade="profile")
+    assert cfg.noise.gyro_noise_std_rad_s == default.noise.gyro_noise_std_rad_s and not cfg.imu_errors.any()
+    # Consumer class: 0.01 deg/s/sqrt(Hz) at the urban 100 Hz, a turn-on draw, the car's vibration.
+    cfg = make_config("urban", duration_s=SHORT_DURATION_S, imu_grade="consumer", seed=4)
+    assert cfg.noise.gyro_noise_std_rad_s == pytest.approx(np.radians(0.01) * 10.0)
+    assert cfg.imu_errors.vibration.any() and cfg.imu_errors.gyro_scale_factor_std_ppm == 5000.0
+    draw = sim.draw_imu_errors(cfg.imu_errors, 4)
+    assert np.asarray(draw.gyro_response).shape == (3, 3)
+    desc = sim.SequenceGenerator(cfg).description()
+    assert (
+        "gyro_turn_on_bias_rad_s" in desc
+        and "gyro_turn_on_bias_rad_s" not in sim.SequenceGenerator(short_config("urban")).description()
+    )
+    assert not make_config("urban", imu_grade="tactical", vibration=False).imu_errors.vibration.any()
+    with pytest.raises(ValueError, match="tactical"):
+        make_config("urban", imu_grade="navigation")
+
+
+def test_ideal_grade_is_the_exact_imu_with_lidar_noise():
+    from farlio.simulation import make_config
+
+    ideal = make_config("handheld", duration_s=SHORT_DURATION_S, imu_grade="ideal")
+    assert ideal.noise.range_noise_std_m > 0.0
+    _, gyro, accel = sim.SequenceGenerator(ideal).imu_arrays()
+    _, gyro_exact, accel_exact = sim.SequenceGenerator(short_config("handheld", noise_free=True)).imu_arrays()
+    np.testing.assert_array_equal(gyro, gyro_exact)
+    np.testing.assert_array_equal(accel, accel_exact)
+
+
+def test_simulate_cli_imu_grade_writes_the_error_model(tmp_path):
+    import yaml
+    from farlio.cli import main
+
+    out = tmp_path / "seq"
+    args = ["simulate", "handheld", "--out", str(out), "--duration", "0.25", "--no-progress"]
+    assert main([*args, "--imu-grade", "industrial", "--seed", "2"]) == 0
+    meta = yaml.safe_load((out / "meta.yaml").read_text())
+    assert float(meta["accel_scale_factor_std_ppm"]) == 1000.0 and int(meta["seed"]) == 2
+    imu = np.loadtxt(out / "imu.csv", delimiter=",", skiprows=1, ndmin=2)
+    assert imu.shape[0] == 51  # 0.25 s at 200 Hz, both ends

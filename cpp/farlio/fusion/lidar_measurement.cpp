@@ -28,8 +28,8 @@ Mat6d fixed_pose_covariance(const FusionConfig& config) {
 
 Eigen::Matrix3d velocity_measurement_covariance(const Mat6d& body_covariance, const Mat6d& previous_body_covariance,
                                                 double dt_s, const FusionConfig& config) {
-  Eigen::Matrix3d C = (body_covariance.topLeftCorner<3, 3>() + previous_body_covariance.topLeftCorner<3, 3>()) /
-                      square(dt_s);
+  Eigen::Matrix3d C =
+      (body_covariance.topLeftCorner<3, 3>() + previous_body_covariance.topLeftCorner<3, 3>()) / square(dt_s);
   C.diagonal().array() += square(config.lidar_velocity_std_m_s);
   return 0.5 * (C + C.transpose());
 }

@@ -35,6 +35,17 @@ ProfileDefaults defaults_of(Profile p) {
 }
 }  // namespace
 
+bool VibrationConfig::any() const {
+  return !accel_wheel_amplitude_m_s2_per_m_s.isZero(0.0) || !gyro_wheel_amplitude_rad_s_per_m_s.isZero(0.0) ||
+         !accel_noise_std_m_s2_per_m_s.isZero(0.0) || !gyro_noise_std_rad_s_per_m_s.isZero(0.0);
+}
+
+bool ImuErrorConfig::any() const {
+  return gyro_turn_on_bias_std_rad_s != 0.0 || accel_turn_on_bias_std_m_s2 != 0.0 || gyro_scale_factor_std_ppm != 0.0 ||
+         accel_scale_factor_std_ppm != 0.0 || gyro_misalignment_std_mrad != 0.0 || accel_misalignment_std_mrad != 0.0 ||
+         gyro_g_sensitivity_std_rad_s_per_m_s2 != 0.0 || vibration.any();
+}
+
 Profile parse_profile(const std::string& name) {
   if (name == "racetrack") return Profile::Racetrack;
   if (name == "urban") return Profile::Urban;

@@ -1,7 +1,7 @@
 #pragma once
 // Configuration of the sequence generator: the profile (scene, trajectory and sensors), the
-// seed, the duration and the noise. default_config(profile) gives the documented defaults
-// (docs/simulation.md).
+// seed, the duration, the noise and the IMU error model. default_config(profile) gives the
+// documented defaults (docs/simulation.md); imu_grade.hpp sets the IMU to a datasheet class.
 #include <Eigen/Core>
 #include <cstdint>
 #include <string>
@@ -25,12 +25,45 @@ struct NoiseConfig {
   Eigen::Vector3d accel_bias_initial_m_s2 = Eigen::Vector3d::Zero();
 };
 
+/// Vibration of the IMU mount that grows with speed (docs/simulation.md, "IMU error model"): a
+/// sinusoid at the wheel rotation frequency speed / (2 pi wheel_radius_m), one random phase per
+/// axis, plus broadband white noise, both with amplitudes proportional to the speed (per axis,
+/// body frame). All zero (the default): no vibration.
+struct VibrationConfig {
+  double wheel_radius_m = 0.3;                                                   ///< sets the wheel-order frequency
+  Eigen::Vector3d accel_wheel_amplitude_m_s2_per_m_s = Eigen::Vector3d::Zero();  ///< sinusoid amplitude / speed
+  Eigen::Vector3d gyro_wheel_amplitude_rad_s_per_m_s = Eigen::Vector3d::Zero();  ///< sinusoid amplitude / speed
+  Eigen::Vector3d accel_noise_std_m_s2_per_m_s = Eigen::Vector3d::Zero();        ///< broadband, per sample / speed
+  Eigen::Vector3d gyro_noise_std_rad_s_per_m_s = Eigen::Vector3d::Zero();        ///< broadband, per sample / speed
+
+  [[nodiscard]] bool any() const;
+};
+
+/// IMU errors beyond NoiseConfig's white noise, bias walk and fixed initial bias (docs/simulation.md,
+/// "IMU error model"). The per-run constants are drawn from the seed (standard deviations per axis or
+/// matrix entry); readings are gyro = (I + S_g + M_g) w + G f, accel = (I + S_a + M_a) f, before
+/// biases and noise. All zero (the default): no such error, and the IMU is bit-identical to the one
+/// NoiseConfig alone gives.
+struct ImuErrorConfig {
+  double gyro_turn_on_bias_std_rad_s = 0.0;            ///< per axis, constant over a run, added to the initial bias
+  double accel_turn_on_bias_std_m_s2 = 0.0;            ///< per axis, constant over a run, added to the initial bias
+  double gyro_scale_factor_std_ppm = 0.0;              ///< diagonal S_g, per axis
+  double accel_scale_factor_std_ppm = 0.0;             ///< diagonal S_a, per axis
+  double gyro_misalignment_std_mrad = 0.0;             ///< off-diagonal M_g (cross-axis coupling), per entry
+  double accel_misalignment_std_mrad = 0.0;            ///< off-diagonal M_a (cross-axis coupling), per entry
+  double gyro_g_sensitivity_std_rad_s_per_m_s2 = 0.0;  ///< G: gyro reading per unit specific force, per entry
+  VibrationConfig vibration;
+
+  [[nodiscard]] bool any() const;
+};
+
 struct SimConfig {
   Profile profile = Profile::Urban;
   std::uint64_t seed = 1;
   double duration_s = 0.0;
   NoiseConfig noise;
-  /// True: exact ranges, no dropouts, IMU without noise or bias.
+  ImuErrorConfig imu_errors;
+  /// True: exact ranges, no dropouts, IMU without noise, bias or any other error.
   bool noise_free = false;
   /// Stamp of the sequence start (t = 0) in ns.
   std::int64_t start_stamp_ns = 0;

@@ -1,7 +1,8 @@
 #pragma once
 // The IMU model: samples the exact body motion (gyro = body angular velocity, accel =
-// R_wb^T (a_world - g_world) with g_world = (0, 0, -gravity)) and adds a bias random walk and
-// white noise per sample, unless noise-free.
+// R_wb^T (a_world - g_world) with g_world = (0, 0, -gravity)) and, unless noise-free, applies the
+// error model: response matrices and g-sensitivity (imu_errors.hpp), vibration (vibration.hpp),
+// then the bias (initial + turn-on + random walk) and white noise of each sample.
 #include <cstdint>
 #include <vector>
 

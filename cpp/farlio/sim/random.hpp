@@ -2,13 +2,15 @@
 // Counter-based random numbers for the simulator. Every draw is a pure function of
 // (seed, stream, index, component), so results do not depend on call order or threads and
 // are bit-identical across platforms (no std:: distributions, whose output is unspecified).
+#include <Eigen/Core>
 #include <cmath>
 #include <cstdint>
 #include <numbers>
 
 namespace farlio::sim {
 
-/// Independent random streams of one sequence.
+/// Independent random streams of one sequence. New streams get new numbers, so adding one leaves
+/// the draws of the others (and so every existing sequence) unchanged.
 enum class Stream : std::uint64_t {
   Layout = 1,
   LidarRange = 2,
@@ -16,7 +18,14 @@ enum class Stream : std::uint64_t {
   ImuGyro = 4,
   ImuAccel = 5,
   ImuGyroBias = 6,
-  ImuAccelBias = 7
+  ImuAccelBias = 7,
+  ImuTurnOnBias = 8,       ///< index 0: gyro, 1: accel
+  ImuScaleFactor = 9,      ///< index 0: gyro, 1: accel
+  ImuMisalignment = 10,    ///< index 0: gyro, 1: accel; component: matrix entry
+  ImuGSensitivity = 11,    ///< component: matrix entry
+  ImuVibrationPhase = 12,  ///< index 0: gyro, 1: accel
+  ImuGyroVibration = 13,   ///< index: sample
+  ImuAccelVibration = 14   ///< index: sample
 };
 
 /// SplitMix64 finaliser: a bijective 64-bit mixer.
@@ -49,6 +58,12 @@ inline double standard_normal(std::uint64_t seed, Stream stream, std::uint64_t i
   const double u1 = uniform01(seed, stream, index, 2 * component);
   const double u2 = uniform01(seed, stream, index ^ kSecondDraw, 2 * component + 1);
   return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * std::numbers::pi * u2);
+}
+
+/// Three independent standard normals (components 0, 1, 2) of one (seed, stream, index).
+inline Eigen::Vector3d standard_normal3(std::uint64_t seed, Stream stream, std::uint64_t index) {
+  return {standard_normal(seed, stream, index, 0), standard_normal(seed, stream, index, 1),
+          standard_normal(seed, stream, index, 2)};
 }
 
 /// A small sequential generator (for laying out scenes) built on the same mixer.

@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "farlio/core/time.hpp"
+#include "farlio/sim/imu_errors.hpp"
 #include "farlio/sim/imu_model.hpp"
 #include "farlio/sim/random.hpp"
 
@@ -34,12 +35,36 @@ std::string num(double v) {
   s << v;
   return s.str();
 }
+
+std::string vec(const Eigen::Vector3d& v) { return "[" + num(v.x()) + ", " + num(v.y()) + ", " + num(v.z()) + "]"; }
+
+/// The error model's fields and the turn-on biases drawn for this seed (only when the model is on,
+/// so that meta.yaml of the default IMU is unchanged).
+void add_imu_errors(const ImuErrorConfig& e, std::uint64_t seed, std::map<std::string, std::string>& d) {
+  const ImuErrorDraw draw = draw_imu_errors(e, seed);
+  d["gyro_turn_on_bias_rad_s"] = vec(draw.gyro_turn_on_bias_rad_s);
+  d["accel_turn_on_bias_m_s2"] = vec(draw.accel_turn_on_bias_m_s2);
+  d["gyro_turn_on_bias_std_rad_s"] = num(e.gyro_turn_on_bias_std_rad_s);
+  d["accel_turn_on_bias_std_m_s2"] = num(e.accel_turn_on_bias_std_m_s2);
+  d["gyro_scale_factor_std_ppm"] = num(e.gyro_scale_factor_std_ppm);
+  d["accel_scale_factor_std_ppm"] = num(e.accel_scale_factor_std_ppm);
+  d["gyro_misalignment_std_mrad"] = num(e.gyro_misalignment_std_mrad);
+  d["accel_misalignment_std_mrad"] = num(e.accel_misalignment_std_mrad);
+  d["gyro_g_sensitivity_std_rad_s_per_m_s2"] = num(e.gyro_g_sensitivity_std_rad_s_per_m_s2);
+  const VibrationConfig& v = e.vibration;
+  d["vibration_wheel_radius_m"] = num(v.wheel_radius_m);
+  d["vibration_accel_wheel_amplitude_m_s2_per_m_s"] = vec(v.accel_wheel_amplitude_m_s2_per_m_s);
+  d["vibration_gyro_wheel_amplitude_rad_s_per_m_s"] = vec(v.gyro_wheel_amplitude_rad_s_per_m_s);
+  d["vibration_accel_noise_std_m_s2_per_m_s"] = vec(v.accel_noise_std_m_s2_per_m_s);
+  d["vibration_gyro_noise_std_rad_s_per_m_s"] = vec(v.gyro_noise_std_rad_s_per_m_s);
+}
 }  // namespace
 
 SequenceGenerator::SequenceGenerator(const SimConfig& config)
     : config_(config), world_(std::make_shared<const World>(build_world(config.profile))) {
   if (!(config_.lidar_rate_hz > 0.0) || !(config_.imu_rate_hz > 0.0) || !(config_.duration_s > 0.0))
     throw std::invalid_argument("SimConfig: lidar_rate_hz, imu_rate_hz and duration_s must be positive");
+  validate_imu_errors(config_.imu_errors);
   period_ns_ = std::llround(kNsPerS / config_.lidar_rate_hz);
 }
 
@@ -193,6 +218,7 @@ std::map<std::string, std::string> SequenceGenerator::description() const {
   d["accel_noise_std_m_s2"] = num(config_.noise.accel_noise_std_m_s2);
   d["gyro_bias_walk_rad_s2_sqrt_hz"] = num(config_.noise.gyro_bias_walk_rad_s2_sqrt_hz);
   d["accel_bias_walk_m_s3_sqrt_hz"] = num(config_.noise.accel_bias_walk_m_s3_sqrt_hz);
+  if (config_.imu_errors.any()) add_imu_errors(config_.imu_errors, config_.seed, d);
   // Trajectory statistics over the duration.
   double max_speed = 0.0, sum_speed = 0.0, max_lateral = 0.0, max_rate = 0.0, path_m = 0.0;
   double z_min = std::numeric_limits<double>::infinity(), z_max = -z_min;

@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from farlio.progress import Progress
-from farlio.simulation import PROFILES, make_config, write_sequence
+from farlio.simulation import IMU_GRADES, PROFILES, make_config, write_sequence
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -24,6 +24,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--duration", type=float, default=None, help="seconds to generate (default: the profile's, docs/simulation.md)"
     )
     parser.add_argument("--noise-free", action="store_true", help="exact ranges, no dropout, IMU without noise/bias")
+    parser.add_argument(
+        "--imu-grade",
+        choices=IMU_GRADES,
+        default="profile",
+        help="profile: the profile's IMU noise (default, unchanged); ideal: no IMU error; consumer (BMI088/"
+        "ICM-42688 class), industrial (ADIS16470/MTi-630 class), tactical (HG4930 class): turn-on bias, bias "
+        "walk, white noise, scale factor, misalignment, g-sensitivity and speed-dependent vibration "
+        "(docs/simulation.md)",
+    )
+    parser.add_argument(
+        "--no-vibration", action="store_true", help="with a datasheet --imu-grade: leave out the platform vibration"
+    )
     parser.add_argument("--range-noise", type=float, default=None, metavar="M", help="range noise std (m)")
     parser.add_argument("--dropout", type=float, default=None, metavar="P", help="chance a ray returns nothing")
     parser.add_argument("--gyro-noise", type=float, default=None, metavar="RAD_S", help="gyro white noise std")
@@ -48,6 +60,8 @@ def run(args: argparse.Namespace) -> int:
         seed=args.seed,
         duration_s=args.duration,
         noise_free=args.noise_free,
+        imu_grade=args.imu_grade,
+        vibration=not args.no_vibration,
         range_noise_std_m=args.range_noise,
         dropout_probability=args.dropout,
         gyro_noise_std_rad_s=args.gyro_noise,
