@@ -89,7 +89,7 @@ inline constexpr double kMaxVoxelCapacity = 2147483647.0;
   FIELD(double, time_budget_factor, 2.0, range::positive_or_inf(),                                                  \
         "time budget in LiDAR periods (paper: 2); a frame over it is dropped (inf: no budget)")                     \
   FIELD(double, damping, 1e-9, range::non_negative(), "lambda added to the diagonal of H")                          \
-  FIELD(double, covariance_scale, 0.01, range::positive(),                                                          \
+  FIELD(double, covariance_scale, 0.05, range::positive(),                                                          \
         "pose covariance = covariance_scale * H^-1 (H in the factors' normalised units; docs/fusion.md measures "   \
         "1e-3..2e-3 on consecutive scans and inflates it for errors shared through the map)")                       \
   FIELD(double, degenerate_translation_std_m, 0.1, range::positive(),                                               \
