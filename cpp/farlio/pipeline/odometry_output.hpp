@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "farlio/core/se3.hpp"
 #include "farlio/pipeline/scan_pipeline.hpp"
@@ -21,6 +22,9 @@ struct OdometryFrame {
   std::int64_t started_ns = 0;     ///< when the pipeline started on it (the odometry's clock)
   std::int64_t available_ns = 0;   ///< when its result reached the fusion
   bool guess_from_fusion = false;  ///< initial guess and undistortion came from the fusion
+  /// The registered scan: the kept (undistorted, downsampled) points in the world frame at the
+  /// registered pose. Filled only by the online odometry when asked to (keep_registered_points).
+  std::vector<Eigen::Vector3f> registered_points;
 };
 
 /// One sample of the 100 Hz odometry output.

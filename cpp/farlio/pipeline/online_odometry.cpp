@@ -6,10 +6,11 @@
 namespace farlio::pipeline {
 
 OnlineOdometry::OnlineOdometry(const Config& config, const SE3& T_imu_lidar, double gravity_m_s2,
-                               OdometryCallback on_odometry, FrameCallback on_frame)
+                               OdometryCallback on_odometry, FrameCallback on_frame, bool keep_registered_points)
     : config_(validated(config)),
       T_imu_lidar_(T_imu_lidar),
       T_lidar_imu_(T_imu_lidar.inverse()),
+      keep_registered_points_(keep_registered_points),
       on_odometry_(std::move(on_odometry)),
       on_frame_(std::move(on_frame)),
       driver_(config.fusion, gravity_m_s2, T_imu_lidar, config.fusion.enabled) {
@@ -85,6 +86,7 @@ void OnlineOdometry::worker_loop() {
 OdometryFrame OnlineOdometry::process(const Scan& scan) {
   OdometryFrame out;
   ScanPrior prior;
+  std::unique_lock pipeline_lock(pipeline_mutex_);
   {
     std::lock_guard lock(state_mutex_);
     if (!mode_decided_) {  // the first scan fixes the mode and the start pose
@@ -99,6 +101,13 @@ OdometryFrame OnlineOdometry::process(const Scan& scan) {
   out.scan = pipeline_->process(scan, prior.guess, prior.motion);
   out.processed = true;
   out.body_pose = out.scan.pose * T_lidar_imu_;
+  if (keep_registered_points_) {
+    out.registered_points = pipeline_->backend().frame_points();
+    const Eigen::Matrix3f R = out.scan.pose.rotation().cast<float>();
+    const Eigen::Vector3f t = out.scan.pose.translation().cast<float>();
+    for (auto& p : out.registered_points) p = R * p + t;
+  }
+  pipeline_lock.unlock();
 
   std::lock_guard lock(state_mutex_);
   driver_.link(scan, out);
@@ -117,6 +126,11 @@ std::optional<fusion::FusionStats> OnlineOdometry::fusion_stats() const {
   std::lock_guard lock(state_mutex_);
   if (!mode_decided_) return std::nullopt;
   return driver_.stats();
+}
+
+map::MapSnapshot OnlineOdometry::map_snapshot() const {
+  std::lock_guard lock(pipeline_mutex_);
+  return pipeline_ ? pipeline_->backend().map_snapshot() : map::MapSnapshot{};
 }
 
 std::size_t OnlineOdometry::scans_dropped_busy() const {
