@@ -333,6 +333,9 @@ void bind_pipeline(nb::module_& m) {
           nb::call_guard<nb::gil_scoped_release>(),
           "(N, 3) float32 copy of the submap's points (world frame); waits for the scan in progress")
       .def_prop_ro("inertial", [](PyOnlineOdometry& o) { return o.odometry.inertial(); })
+      .def_prop_ro(
+          "fusion_stats", [](PyOnlineOdometry& o) { return o.odometry.fusion_stats(); },
+          "The fusion's counters and gyro bias (None before the first scan or LiDAR-only).")
       .def_prop_ro("scans_dropped_busy", [](PyOnlineOdometry& o) { return o.odometry.scans_dropped_busy(); });
 
   nb::class_<pipeline::ScanPipeline>(m, "ScanPipeline",

@@ -55,6 +55,16 @@ def scan_interval(cur: Cloud, nxt: Cloud | None, prev: tuple[int, int] | None) -
     return start, start + max(period, 1)
 
 
+def live_interval(cur: Cloud, prev_header_ns: int | None) -> tuple[int, int]:
+    """Scan start and end of `cur` when the next cloud is not known yet (live): the gap from the
+    previous header stamp is the period (exact for a LiDAR at a constant rate); without a plausible
+    one, as scan_interval does for a lone cloud."""
+    gap = cur.stamp_ns - prev_header_ns if prev_header_ns is not None else 0
+    if not 0 < gap <= MAX_SCAN_SPAN_NS:
+        return scan_interval(cur, None, None)
+    return (cur.stamp_ns - gap, cur.stamp_ns) if cur.header_is_end else (cur.stamp_ns, cur.stamp_ns + gap)
+
+
 def caught_up(others: list[TimedClouds], end: int) -> bool:
     """Whether every other LiDAR has delivered points at or after `end` (its clouds for the period
     ending there are complete)."""
