@@ -334,6 +334,12 @@ void bind_pipeline(nb::module_& m) {
           "(N, 3) float32 copy of the submap's points (world frame); waits for the scan in progress")
       .def_prop_ro("inertial", [](PyOnlineOdometry& o) { return o.odometry.inertial(); })
       .def_prop_ro(
+          "device", [](PyOnlineOdometry& o) { return device_name(o.odometry.device()); },
+          "'cpu' or 'cuda': the backend the scan pipeline runs on")
+      .def_prop_ro(
+          "device_message", [](PyOnlineOdometry& o) { return o.odometry.device_message(); },
+          "why device auto fell back to the CPU ('' when it did not)")
+      .def_prop_ro(
           "fusion_stats", [](PyOnlineOdometry& o) { return o.odometry.fusion_stats(); },
           "The fusion's counters and gyro bias (None before the first scan or LiDAR-only).")
       .def_prop_ro("scans_dropped_busy", [](PyOnlineOdometry& o) { return o.odometry.scans_dropped_busy(); });

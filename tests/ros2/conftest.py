@@ -16,6 +16,8 @@ import pytest
 os.environ["ROS_DOMAIN_ID"] = str(random.randint(1, 100))
 os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
 os.environ.pop("ROS_STATIC_PEERS", None)
+for _name in ("FASTRTPS_DEFAULT_PROFILES_FILE", "FASTDDS_DEFAULT_PROFILES_FILE"):
+    os.environ.pop(_name, None)
 
 
 from loopback import SEQUENCE_S, NodeProcess, Recorder  # noqa: E402
@@ -25,7 +27,9 @@ from loopback import SEQUENCE_S, NodeProcess, Recorder  # noqa: E402
 def ros():
     """rclpy for the recorder (one context for the session)."""
     import rclpy
+    from farlio.ros2 import choose_transport
 
+    choose_transport("large-data")  # as the node and the player (clouds through shared memory)
     rclpy.init()
     yield rclpy
     rclpy.try_shutdown()

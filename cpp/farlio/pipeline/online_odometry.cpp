@@ -13,7 +13,8 @@ OnlineOdometry::OnlineOdometry(const Config& config, const SE3& T_imu_lidar, dou
       keep_registered_points_(keep_registered_points),
       on_odometry_(std::move(on_odometry)),
       on_frame_(std::move(on_frame)),
-      driver_(config.fusion, gravity_m_s2, T_imu_lidar, config.fusion.enabled) {
+      driver_(config.fusion, gravity_m_s2, T_imu_lidar, config.fusion.enabled),
+      pipeline_(config_) {
   worker_ = std::thread([this] { worker_loop(); });
 }
 
@@ -92,17 +93,17 @@ OdometryFrame OnlineOdometry::process(const Scan& scan) {
     if (!mode_decided_) {  // the first scan fixes the mode and the start pose
       mode_decided_ = true;
       if (!driver_.has_imu()) driver_.stop_fusion();
-      pipeline_.emplace(config_, driver_.start_pose(scan.end_stamp_ns) * T_imu_lidar_);
+      pipeline_.reset_initial_pose(driver_.start_pose(scan.end_stamp_ns) * T_imu_lidar_);
     }
     prior = driver_.prior(scan);
     out.started_ns = driver_.inertial() ? driver_.clock_ns() : scan.end_stamp_ns;
   }
   out.guess_from_fusion = prior.guess.has_value();
-  out.scan = pipeline_->process(scan, prior.guess, prior.motion);
+  out.scan = pipeline_.process(scan, prior.guess, prior.motion);
   out.processed = true;
   out.body_pose = out.scan.pose * T_lidar_imu_;
   if (keep_registered_points_) {
-    out.registered_points = pipeline_->backend().frame_points();
+    out.registered_points = pipeline_.backend().frame_points();
     const Eigen::Matrix3f R = out.scan.pose.rotation().cast<float>();
     const Eigen::Vector3f t = out.scan.pose.translation().cast<float>();
     for (auto& p : out.registered_points) p = R * p + t;
@@ -130,8 +131,12 @@ std::optional<fusion::FusionStats> OnlineOdometry::fusion_stats() const {
 
 map::MapSnapshot OnlineOdometry::map_snapshot() const {
   std::lock_guard lock(pipeline_mutex_);
-  return pipeline_ ? pipeline_->backend().map_snapshot() : map::MapSnapshot{};
+  return pipeline_.frames() > 0 ? pipeline_.backend().map_snapshot() : map::MapSnapshot{};
 }
+
+Device OnlineOdometry::device() const { return pipeline_.backend().device(); }
+
+const std::string& OnlineOdometry::device_message() const { return pipeline_.device_message(); }
 
 std::size_t OnlineOdometry::scans_dropped_busy() const {
   std::lock_guard lock(state_mutex_);

@@ -56,6 +56,10 @@ class OnlineOdometry {
   [[nodiscard]] std::optional<fusion::FusionStats> fusion_stats() const;
   /// Scans dropped because the worker was busy.
   [[nodiscard]] std::size_t scans_dropped_busy() const;
+  /// The backend the scan pipeline runs on (chosen at construction) and why auto fell back to the
+  /// CPU ('' when it did not).
+  [[nodiscard]] Device device() const;
+  [[nodiscard]] const std::string& device_message() const;
   /// A host copy of the submap (world frame); empty before the first scan. Waits for the scan in
   /// progress, if any.
   [[nodiscard]] map::MapSnapshot map_snapshot() const;
@@ -83,9 +87,9 @@ class OnlineOdometry {
   std::condition_variable queue_cv_;
   std::optional<Scan> pending_;
   bool busy_ = false, stopping_ = false;
-  mutable std::mutex pipeline_mutex_;     // held by the worker while it processes, and by map_snapshot
-  std::optional<ScanPipeline> pipeline_;  // created at the first scan
-  std::thread worker_;
+  mutable std::mutex pipeline_mutex_;  // held by the worker while it processes, and by map_snapshot
+  ScanPipeline pipeline_;              // its backend made at construction; the start pose set at the first scan
+  std::thread worker_;                 // last: started when everything above is constructed
 };
 
 }  // namespace farlio::pipeline

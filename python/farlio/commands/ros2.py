@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import argparse
 
-from farlio.ros2 import require_rclpy
+from farlio.ros2 import add_transport_argument, choose_transport, require_rclpy
 from farlio.ros2.params import default_params_yaml
 
 
@@ -15,6 +15,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "parameter with its default and meaning: farlio ros2 --print-params"
     )
     parser.add_argument("--print-params", action="store_true", help="print the default parameter file (YAML) and exit")
+    add_transport_argument(parser)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -22,6 +23,7 @@ def run(args: argparse.Namespace) -> int:
         print(default_params_yaml(), end="")
         return 0
     require_rclpy()
+    transport = choose_transport(args.transport)
     from farlio.ros2.node import run as run_node
 
-    return run_node(args.ros_args)
+    return run_node(args.ros_args, transport)

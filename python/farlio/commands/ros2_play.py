@@ -7,7 +7,7 @@ from pathlib import Path
 
 from farlio.datasets import FORMAT_HELP, FORMATS, LoadOptions, open_dataset
 from farlio.datasets.pointcloud2_encode import CONVENTIONS
-from farlio.ros2 import require_rclpy
+from farlio.ros2 import add_transport_argument, choose_transport, require_rclpy
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -49,6 +49,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--max-scans", type=int, default=None, help="stop after this many scans")
     parser.add_argument("--clock", action="store_true", help="also publish /clock at the IMU stamps (use_sim_time)")
+    add_transport_argument(parser)
     rec = parser.add_argument_group("recordings with several topics (bags)")
     rec.add_argument("--in-lidar-topic", dest="in_lidar_topics", action="append", default=[], metavar="TOPIC")
     rec.add_argument("--in-imu-topic", default=None, metavar="TOPIC")
@@ -57,6 +58,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     require_rclpy()
+    transport = choose_transport(args.transport)
     from farlio.ros2.play import PlayOptions, play
 
     if args.rate <= 0:
@@ -79,6 +81,7 @@ def run(args: argparse.Namespace) -> int:
         ),
         args.ros_args,
     )
+    print(f"transport: {transport}")
     print(
         f"published {stats.scans} scans ({stats.clouds} clouds) and {stats.imu} IMU samples in {stats.wall_s:.1f} s; "
         f"at most {stats.late_s * 1000:.1f} ms late"

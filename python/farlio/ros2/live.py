@@ -209,16 +209,21 @@ class LiveOdometry:
         wait_ns = int(self.params.lidar_merge_wait_s * NS_PER_S)
         while self._refs:
             cloud, arrival, (start, end) = self._refs[0]
-            if not self._others_caught_up(end) and self.clock() - arrival < wait_ns:
+            if not self._others_caught_up(cloud.stamp_ns, end) and self.clock() - arrival < wait_ns:
                 return
             self._refs.popleft()
             has_time = all(self._has_time)
             self._submit(assemble(cloud, start, end, self._others, self.extrinsics, has_time), arrival)
 
-    def _others_caught_up(self, end: int) -> bool:
-        """Whether every other LiDAR's newest cloud covers its part of the period ending at `end`."""
+    def _others_caught_up(self, header: int, end: int) -> bool:
+        """Whether every other LiDAR has sent its part of the reference period (header stamp
+        `header`, ending at `end`): its newest cloud has a header at or after the reference's (it
+        started a period there, so its previous one is complete), or its period ends at `end`."""
         slack = MERGE_SLACK_S * NS_PER_S
-        return all(e >= end - slack for e in self._period_end[1:])
+        return all(
+            (h is not None and h >= header) or e >= end - slack
+            for h, e in zip(self._prev_header[1:], self._period_end[1:])
+        )
 
     def _submit(self, scan: farlio.Scan, arrival: int) -> None:
         if self._last_scan_end is not None and scan.end_stamp_ns <= self._last_scan_end:

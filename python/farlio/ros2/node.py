@@ -74,8 +74,11 @@ class FarlioNode(Node):
         self._results = threading.Thread(target=self._result_loop, name="farlio-results", daemon=True)
         self._results.start()
         p = self.params
+        if self.live.odometry.device_message:
+            self.get_logger().warning(self.live.odometry.device_message)
+        imu = p.imu_topic if p.uses_imu else "(none)"
         self.get_logger().info(
-            f"farlio: IMU {p.imu_topic if p.uses_imu else '(none)'}, LiDAR {', '.join(p.lidar_topics)}, "
+            f"farlio on {self.live.odometry.device}: IMU {imu}, LiDAR {', '.join(p.lidar_topics)}, "
             f"frames {p.odom_frame} -> {p.base_frame}, time offset {p.time_offset_s} s, "
             f"{'TF on /tf' if self._tf_pub else 'no /tf (tf2_msgs is not installed)'}"
         )
@@ -263,12 +266,15 @@ class FarlioNode(Node):
         print("farlio stopped: " + ", ".join(f"{k} {v}" for k, v in counts.items()), file=sys.stderr)
 
 
-def run(ros_args: list[str]) -> int:
-    """`farlio ros2 [--ros-args ...]`: runs the node until SIGINT (or the context shuts down)."""
+def run(ros_args: list[str], transport: str = "") -> int:
+    """`farlio ros2 [--ros-args ...]`: runs the node until SIGINT (or the context shuts down);
+    `transport` says which DDS transport settings are in use (for the log)."""
     rclpy.init(args=[NODE_NAME, *ros_args])
     node = None
     try:
         node = FarlioNode()
+        if transport:
+            node.get_logger().info(f"transport: {transport}")
         executor = SingleThreadedExecutor()
         executor.add_node(node)
         executor.spin()
