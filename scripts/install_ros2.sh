@@ -3,7 +3,8 @@
 # for `.venv-ros/bin/farlio ros2` and `.venv-ros/bin/farlio ros2-play` (docs/ros2.md). Run after
 # scripts/install_deps.sh: farlio is built once by .venv (the same build folder as
 # `pip install .`, so nothing is compiled twice) and its wheel installed here. Safe to run again
-# (idempotent; pip's cache makes a re-run take seconds). tf2_msgs has no wheel on PyPI: without
+# (idempotent; pip's cache makes a re-run take seconds); `--farlio-only` just reinstalls farlio's
+# wheel (what scripts/test.sh does before the ROS tests). tf2_msgs has no wheel on PyPI: without
 # it the node publishes no /tf (docs/ros2.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -16,11 +17,13 @@ if [ ! -x "$VENV/bin/python" ]; then
   echo "install_ros2.sh: $VENV is missing: run scripts/install_deps.sh first" >&2
   exit 1
 fi
-if [ ! -x .venv-ros/bin/python ]; then
-  echo "[install] creating .venv-ros with $($PY --version)"
-  $PY -m venv .venv-ros
+if [ "${1:-}" != --farlio-only ]; then
+  if [ ! -x .venv-ros/bin/python ]; then
+    echo "[install] creating .venv-ros with $($PY --version)"
+    $PY -m venv .venv-ros
+  fi
+  .venv-ros/bin/python "${PIP[@]}" install -r scripts/requirements-ros2.txt
 fi
-.venv-ros/bin/python "${PIP[@]}" install -r scripts/requirements-ros2.txt
 
 # farlio: the wheel of this tree, built by .venv (incremental), installed without its deps
 # (installed above)

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 import random
+from pathlib import Path
 
 import pytest
 
@@ -58,8 +59,8 @@ def start_node(tmp_path):
     """start_node(*params) -> NodeProcess; every node still running at the end is stopped."""
     nodes: list[NodeProcess] = []
 
-    def start(*params: str) -> NodeProcess:
-        nodes.append(NodeProcess(tmp_path / f"node{len(nodes)}.log", *params))
+    def start(*params: str, params_file: Path | None = None) -> NodeProcess:
+        nodes.append(NodeProcess(tmp_path / f"node{len(nodes)}.log", *params, params_file=params_file))
         return nodes[-1]
 
     yield start

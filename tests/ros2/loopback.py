@@ -36,11 +36,12 @@ def wait_for(condition: Callable[[], bool], timeout_s: float, what: str) -> None
 
 
 class NodeProcess:
-    """`farlio ros2 --ros-args -p name:=value ...` in a subprocess, its output in `log`."""
+    """`farlio ros2 --ros-args [--params-file F] -p name:=value ...` in a subprocess, its output in
+    `log`."""
 
-    def __init__(self, log: Path, *params: str):
+    def __init__(self, log: Path, *params: str, params_file: Path | None = None):
+        args = (["--params-file", str(params_file)] if params_file else []) + [a for p in params for a in ("-p", p)]
         self.log = log
-        args = [a for p in params for a in ("-p", p)]
         self._out = open(log, "w")  # noqa: SIM115 - closed in stop()
         self.proc = subprocess.Popen(
             farlio_command("ros2", "--ros-args", *args), stdout=self._out, stderr=subprocess.STDOUT

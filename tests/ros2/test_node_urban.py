@@ -5,11 +5,14 @@ the map service, and a clean stop on SIGINT."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 pytest.importorskip("rclpy")
 
+import farlio  # noqa: E402
 from farlio import _core  # noqa: E402
 from farlio._core import NS_PER_S  # noqa: E402
 from farlio.datasets.calib import se3_from_quaternion  # noqa: E402
@@ -35,7 +38,9 @@ def accuracy(estimate, groundtruth) -> tuple[float, float]:
 def test_urban_over_loopback_matches_farlio_run(urban, recorder, start_node, tmp_path):
     path, ds = urban
     map_file = tmp_path / "map.ply"
-    node = start_node(f"calib_file:={path / 'calib.yaml'}", f"map_file:={map_file}")
+    # the shipped parameter file, read by rcl's parser, with overrides
+    params_file = Path(farlio.__file__).parent / "ros2" / "share" / "params.yaml"
+    node = start_node(f"calib_file:={path / 'calib.yaml'}", f"map_file:={map_file}", params_file=params_file)
     recorder.wait_for_node(node)
     play(path)
     n = len(ds)

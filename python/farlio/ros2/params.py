@@ -7,6 +7,7 @@ parameter file (params.yaml) and the docs are generated from the same lists.
 from __future__ import annotations
 
 import dataclasses
+import textwrap
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -16,6 +17,8 @@ from farlio import Config
 from farlio.datasets.pointcloud2 import HEADER_STAMPS, TIME_UNITS, TimeOptions
 
 NODE_NAME = "farlio"
+#: columns of the generated parameter file
+YAML_WIDTH = 100
 #: values of input_qos
 INPUT_QOS = ("reliable", "best_effort")
 
@@ -144,7 +147,7 @@ def default_params_yaml() -> str:
     ]
 
     def entry(name: str, value: Any, doc: str) -> None:
-        lines.append(f"    # {doc}")
+        lines.extend(textwrap.wrap(doc, YAML_WIDTH, initial_indent="    # ", subsequent_indent="    #   "))
         text = yaml.safe_dump({name: value}, default_flow_style=True, width=1000).strip()
         lines.append(f"    {text[1:-1] if text.startswith('{') else text}")
 
