@@ -38,12 +38,13 @@ def ros():
 
 @pytest.fixture(scope="session")
 def urban(tmp_path_factory):
-    """A generated urban sequence (SEQUENCE_S long) and its dataset."""
+    """A generated urban sequence (SEQUENCE_S long, noise seed FARLIO_ROS_TEST_SEED or 1) and its
+    dataset."""
     from farlio.datasets import open_dataset
     from farlio.simulation import generate
 
     path = tmp_path_factory.mktemp("ros2") / "urban"
-    generate("urban", path, duration_s=SEQUENCE_S)
+    generate("urban", path, duration_s=SEQUENCE_S, seed=int(os.environ.get("FARLIO_ROS_TEST_SEED", "1")))
     return path, open_dataset(path)
 
 

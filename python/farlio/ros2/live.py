@@ -74,8 +74,8 @@ class Counters:
 
 @dataclass
 class FrameReport:
-    """A scan's result with when its (reference) cloud arrived and when the result was taken,
-    in ns of the monotonic clock."""
+    """A scan's result with when its (reference) cloud arrived and when the result was taken (the
+    node moves done_ns to when it has published the scan odometry), ns of the monotonic clock."""
 
     frame: Any  # farlio._core.OdometryFrame
     arrival_ns: int

@@ -179,6 +179,7 @@ class FarlioNode(Node):
             self.live.report("poses_non_finite", f"non-finite scan pose at {stamp} ns not published")
         if ok:
             self._scan_pub.publish(conv.odometry_msg(stamp, f.body_pose, p.odom_frame, p.base_frame))
+            report.done_ns = time.monotonic_ns()  # the latency ends with the scan odometry out
             if not self.live.odometry.inertial:  # LiDAR-only: the odometry at the scan rate
                 self._publish_odometry(stamp, f.body_pose)
             if p.publish_cloud_registered:
@@ -200,7 +201,8 @@ class FarlioNode(Node):
             "processed": f.processed,
             "fused": f.fused,
             "drop_reason": f.drop_reason,
-            "latency_ms": report.latency_s * MS_PER_S,
+            "arrival_ns": report.arrival_ns,  # monotonic clock
+            "latency_ms": report.latency_s * MS_PER_S,  # cloud arrival -> scan odometry published
             "pipeline_ms": r.timings.total_s * MS_PER_S,
             "iterations": r.iterations,
             "converged": r.converged,

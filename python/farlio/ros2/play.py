@@ -59,6 +59,8 @@ class PlayStats:
     imu: int = 0
     wall_s: float = 0.0
     late_s: float = 0.0  # the most a message was published after its due time
+    #: scan end stamp (as published) -> monotonic ns when its clouds were published
+    sent_ns: dict[int, int] = field(default_factory=dict)
 
 
 def sector_split(points: np.ndarray, parts: int) -> list[np.ndarray]:
@@ -144,6 +146,7 @@ class Player:
             for pub, msg in zip(self.cloud_pubs, msgs):
                 pub.publish(msg)
                 self.stats.clouds += 1
+            self.stats.sent_ns[end + self.shift_ns] = time.monotonic_ns()
             self.stats.scans += 1
             if i + 1 < self.scans:
                 nxt = self.dataset.scan(i + 1)
