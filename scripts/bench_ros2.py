@@ -44,11 +44,11 @@ def cpu_s(pid: int) -> float:
     return (int(fields[11]) + int(fields[12])) / CLK_TCK
 
 
-def pipeline_cpu_s(ds, scans: int) -> float:
+def pipeline_cpu_s(ds, scans: int, config) -> float:
     """CPU time of the same scans and IMU through OnlineOdometry alone (lockstep, this process)."""
     import farlio
 
-    odo = farlio.OnlineOdometry(farlio.Config(), ds.T_imu_lidar(), ds.gravity_m_s2(), True)
+    odo = farlio.OnlineOdometry(config, ds.T_imu_lidar(), ds.gravity_m_s2(), True)
     imu, k = ds.imu(), 0
     loaded = [ds.scan(i) for i in range(scans)]
     start = time.process_time()
@@ -64,6 +64,12 @@ def pipeline_cpu_s(ds, scans: int) -> float:
     return time.process_time() - start
 
 
+def farlio_fields() -> set[str]:
+    import farlio
+
+    return {name for name, *_ in farlio.Config.fields()}
+
+
 def stats(values_ms: list[float]) -> str:
     if not values_ms:
         return "n/a"
@@ -76,6 +82,7 @@ def main() -> int:
     ap.add_argument("--scans", type=int, default=100)
     ap.add_argument("--input-qos", default="reliable", choices=["reliable", "best_effort"])
     ap.add_argument("--transport", default="large-data", choices=["large-data", "ros-default"])
+    ap.add_argument("--param", action="append", default=[], metavar="NAME:=VALUE", help="a node parameter (repeatable)")
     ap.add_argument("--json", type=Path, default=None)
     args = ap.parse_args()
 
@@ -98,10 +105,14 @@ def main() -> int:
     seq = tmp / "urban"
     generate("urban", seq, duration_s=args.scans / 10 + 0.5)
     ds = open_dataset(seq)
-    base_cpu = pipeline_cpu_s(ds, args.scans)
+    from farlio.config import load_config
+
+    config_overrides = [p.replace(":=", "=", 1) for p in args.param if p.split(":=")[0] in farlio_fields()]
+    base_cpu = pipeline_cpu_s(ds, args.scans, load_config(None, config_overrides))
 
     cmd = [sys.executable, "-m", "farlio.cli", "ros2", "--transport", args.transport, "--ros-args"]
     cmd += ["-p", f"calib_file:={seq / 'calib.yaml'}", "-p", f"input_qos:={args.input_qos}"]
+    cmd += [a for p in args.param for a in ("-p", p)]
     log = open(tmp / "node.log", "w")  # noqa: SIM115
     node_proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT)
 

@@ -58,3 +58,9 @@ def test_launch_file_starts_the_node_with_the_parameter_file(monkeypatch):
     cmd = [c.args[0] if type(c).__name__ == "LaunchConfiguration" else c for c in process.kwargs["cmd"]]
     assert cmd == ["farlio", "ros2", "--ros-args", "--params-file", "params_file"]
     assert all(name in declared for name in ("farlio", "params_file"))
+
+
+def test_docs_name_every_node_parameter():
+    docs = (Path(__file__).parents[2] / "docs" / "ros2.md").read_text()
+    missing = [n for n, *_ in node_param_docs() if f"| `{n}` |" not in docs]
+    assert not missing, f"docs/ros2.md lacks {missing}"
