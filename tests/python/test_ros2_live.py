@@ -176,3 +176,20 @@ def test_parameters_name_every_config_field_and_check_values():
         with pytest.raises(ValueError):
             node_params_from(bad)
     assert NodeParams().uses_imu and not node_params_from({"imu_topic": "none"}).uses_imu
+
+
+def test_a_silent_topic_is_reported_once_per_silence(urban):
+    ds, scans = urban
+    clock = Clock()
+    node = live(ds, [], clock=clock, silent_topic_timeout_s=0.5)
+    clock.ns = 400_000_000
+    assert node.silent_topics() == ([], [])
+    clock.ns = 600_000_000  # nothing since the start
+    fell, _ = node.silent_topics()
+    assert sorted(fell) == ["/imu", "/points"] and not node.has_seen("/imu")
+    assert node.silent_topics() == ([], [])  # reported once
+    node.add_imu(ds.imu()[0])
+    assert node.silent_topics() == ([], ["/imu"])
+    clock.ns = 1_200_000_000
+    assert node.silent_topics() == (["/imu"], []) and node.stats.silent_topics == 3
+    node.stop()
