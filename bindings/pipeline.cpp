@@ -6,6 +6,8 @@
 #include <nanobind/stl/tuple.h>
 #include <nanobind/stl/vector.h>
 
+#include <chrono>
+#include <condition_variable>
 #include <mutex>
 #include <utility>
 
@@ -37,10 +39,11 @@ struct PyOdometry {
 /// into Python (and so never needs the GIL).
 struct PyOnlineOdometry {
   std::mutex mutex;
+  std::condition_variable frame_ready;
   std::vector<pipeline::OdometrySample> samples;
   std::vector<pipeline::OdometryFrame> frames;
   pipeline::OnlineOdometry odometry;
-  PyOnlineOdometry(const Config& c, const SE3& T, double g)
+  PyOnlineOdometry(const Config& c, const SE3& T, double g, bool keep_registered_points)
       : odometry(
             c, T, g,
             [this](const pipeline::OdometrySample& s) {
@@ -48,15 +51,25 @@ struct PyOnlineOdometry {
               samples.push_back(s);
             },
             [this](const pipeline::OdometryFrame& f) {
-              std::lock_guard lock(mutex);
-              frames.push_back(f);
-            }) {}
+              {
+                std::lock_guard lock(mutex);
+                frames.push_back(f);
+              }
+              frame_ready.notify_all();
+            },
+            keep_registered_points) {}
   ~PyOnlineOdometry() { odometry.stop(); }  // before the vectors the callbacks fill go away
   /// Empties one of the collected vectors and returns its contents.
   template <typename T>
   std::vector<T> take(std::vector<T>& collected) {
     std::lock_guard lock(mutex);
     return std::exchange(collected, {});
+  }
+  /// The frames collected so far, waiting up to timeout_s for one when there are none.
+  std::vector<pipeline::OdometryFrame> wait_frames(double timeout_s) {
+    std::unique_lock lock(mutex);
+    frame_ready.wait_for(lock, std::chrono::duration<double>(timeout_s), [this] { return !frames.empty(); });
+    return std::exchange(frames, {});
   }
 };
 
@@ -80,12 +93,19 @@ std::string text_of(nb::handle value) {
   return nb::cast<std::string>(nb::str(value));
 }
 
-Eigen::MatrixX3f map_points(const pipeline::ScanBackend& b) {
-  std::vector<Eigen::Vector3f> pts;
-  b.map_snapshot().for_each_point([&](const Eigen::Vector3f& x, const map::Cov3&, bool) { pts.push_back(x); });
-  Eigen::MatrixX3f out(static_cast<Eigen::Index>(pts.size()), 3);
+/// (N, 3) float32 rows, as numpy wants them.
+using PointRows = Eigen::Matrix<float, Eigen::Dynamic, 3, Eigen::RowMajor>;
+
+PointRows point_rows(const std::vector<Eigen::Vector3f>& pts) {
+  PointRows out(static_cast<Eigen::Index>(pts.size()), 3);
   for (std::size_t i = 0; i < pts.size(); ++i) out.row(static_cast<Eigen::Index>(i)) = pts[i].transpose();
   return out;
+}
+
+PointRows map_points(const map::MapSnapshot& snapshot) {
+  std::vector<Eigen::Vector3f> pts;
+  snapshot.for_each_point([&](const Eigen::Vector3f& x, const map::Cov3&, bool) { pts.push_back(x); });
+  return point_rows(pts);
 }
 
 }  // namespace
@@ -233,6 +253,10 @@ void bind_pipeline(nb::module_& m) {
       .def_ro("available_ns", &pipeline::OdometryFrame::available_ns)
       .def_ro("guess_from_fusion", &pipeline::OdometryFrame::guess_from_fusion)
       .def_ro("degeneracy", &pipeline::OdometryFrame::degeneracy, "Degeneracy of a registered scan, else None")
+      .def_prop_ro(
+          "registered_points", [](const pipeline::OdometryFrame& f) { return point_rows(f.registered_points); },
+          "(N, 3) float32: the undistorted, downsampled scan in the world frame at the registered pose "
+          "(OnlineOdometry with keep_registered_points; else empty)")
       .def("__repr__", attribute_repr({"processed", "fused", "drop_reason", "started_ns", "available_ns",
                                        "guess_from_fusion", "body_pose", "scan"}));
   nb::class_<fusion::FusionStats>(m, "FusionStats")
@@ -276,7 +300,8 @@ void bind_pipeline(nb::module_& m) {
       .def_prop_ro("fusion_stats", [](const PyOdometry& o) { return o.odometry.fusion_stats(); })
       .def_prop_ro("initial_body_pose", [](const PyOdometry& o) { return o.odometry.initial_body_pose(); })
       .def(
-          "map_points", [](const PyOdometry& o) { return map_points(o.odometry.scan_pipeline().backend()); },
+          "map_points",
+          [](const PyOdometry& o) { return map_points(o.odometry.scan_pipeline().backend().map_snapshot()); },
           "(N, 3) float32 copy of the submap's points (world frame)")
       .def_prop_ro("map_memory_bytes",
                    [](const PyOdometry& o) { return o.odometry.scan_pipeline().backend().memory_bytes(); })
@@ -295,7 +320,8 @@ void bind_pipeline(nb::module_& m) {
   nb::class_<PyOnlineOdometry>(m, "OnlineOdometry",
                                "LIO for live data: push IMU samples and scans as they arrive (any thread); the scan "
                                "pipeline runs on a worker; poll the 100 Hz odometry and the per-scan frames.")
-      .def(nb::init<const Config&, const SE3&, double>(), "config"_a, "T_imu_lidar"_a, "gravity_m_s2"_a = 9.81)
+      .def(nb::init<const Config&, const SE3&, double, bool>(), "config"_a, "T_imu_lidar"_a, "gravity_m_s2"_a = 9.81,
+           "keep_registered_points"_a = false)
       .def(
           "add_imu", [](PyOnlineOdometry& o, const ImuSample& s) { o.odometry.add_imu(s); }, "sample"_a,
           nb::call_guard<nb::gil_scoped_release>())
@@ -313,7 +339,22 @@ void bind_pipeline(nb::module_& m) {
       .def(
           "take_frames", [](PyOnlineOdometry& o) { return o.take(o.frames); },
           "What happened to each scan since the last call (processed or dropped, pose, timings).")
+      .def("wait_frames", &PyOnlineOdometry::wait_frames, "timeout_s"_a, nb::call_guard<nb::gil_scoped_release>(),
+           "As take_frames, but waits up to timeout_s for a frame when there is none yet.")
+      .def(
+          "map_points", [](const PyOnlineOdometry& o) { return map_points(o.odometry.map_snapshot()); },
+          nb::call_guard<nb::gil_scoped_release>(),
+          "(N, 3) float32 copy of the submap's points (world frame); waits for the scan in progress")
       .def_prop_ro("inertial", [](PyOnlineOdometry& o) { return o.odometry.inertial(); })
+      .def_prop_ro(
+          "device", [](PyOnlineOdometry& o) { return device_name(o.odometry.device()); },
+          "'cpu' or 'cuda': the backend the scan pipeline runs on")
+      .def_prop_ro(
+          "device_message", [](PyOnlineOdometry& o) { return o.odometry.device_message(); },
+          "why device auto fell back to the CPU ('' when it did not)")
+      .def_prop_ro(
+          "fusion_stats", [](PyOnlineOdometry& o) { return o.odometry.fusion_stats(); },
+          "The fusion's counters and gyro bias (None before the first scan or LiDAR-only).")
       .def_prop_ro("scans_dropped_busy", [](PyOnlineOdometry& o) { return o.odometry.scans_dropped_busy(); });
 
   nb::class_<pipeline::ScanPipeline>(m, "ScanPipeline",
@@ -328,7 +369,7 @@ void bind_pipeline(nb::module_& m) {
           "Registers one scan; without a guess the constant-velocity model supplies one.")
       .def_prop_ro("frames", &pipeline::ScanPipeline::frames)
       .def(
-          "map_points", [](const pipeline::ScanPipeline& p) { return map_points(p.backend()); },
+          "map_points", [](const pipeline::ScanPipeline& p) { return map_points(p.backend().map_snapshot()); },
           "(N, 3) float32 copy of the submap's points (world frame)")
       .def_prop_ro("map_memory_bytes", [](const pipeline::ScanPipeline& p) { return p.backend().memory_bytes(); })
       .def_prop_ro(

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Runs every test of farlio: the style check (clang-format, ruff), the C++ tests (ctest), the
 # same C++ tests under AddressSanitizer + UndefinedBehaviorSanitizer, and the Python tests
-# (pytest) against the installed package. The
+# (pytest) against the installed package, and the ROS 2 node over loopback (tests/ros2, in
+# .venv-ros from scripts/install_ros2.sh; skipped without it). The
 # GPU tests are built and skip without a GPU; scripts/gpu_check.sh runs them on one.
 # Expects scripts/install_deps.sh to have run. Tests that need ../shared/data or a GPU skip
 # cleanly when it is absent.
@@ -25,6 +26,14 @@ ctest --preset dev
 echo "== Python package (pip install .) and tests =="
 .venv/bin/python -m pip install -q --no-build-isolation .
 .venv/bin/python -m pytest -q tests/python
+
+echo "== ROS 2 node over loopback (.venv-ros, tests/ros2) =="
+if [ -x .venv-ros/bin/python ] && .venv-ros/bin/python -c "import rclpy" 2>/dev/null; then
+  bash scripts/install_ros2.sh --farlio-only  # this tree's farlio (the build above, not compiled again)
+  .venv-ros/bin/python -m pytest -q -p no:warnings tests/ros2
+else
+  echo "skipped: no .venv-ros with rclpy (scripts/install_ros2.sh could not install the ROS 2 wheels)"
+fi
 
 if [ "${FARLIO_SKIP_SANITIZERS:-0}" != 1 ]; then
   echo "== C++ tests under ASan + UBSan (preset asan) =="

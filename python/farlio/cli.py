@@ -18,6 +18,11 @@ COMMANDS = {
     "ablate": ("farlio.commands.ablate", "component ablation (EKF, DC, MU, SA GICP, ASMD) on a recording"),
     "latency-sweep": ("farlio.commands.latency_sweep", "APE as the pipeline latency grows (added delays)"),
     "bench": ("farlio.commands.bench", "whole-frame latency next to KISS-ICP on the same scans"),
+    "ros2": ("farlio.commands.ros2", "the ROS 2 node: live IMU and PointCloud2 topics in, odometry out (.venv-ros)"),
+    "ros2-play": (
+        "farlio.commands.ros2_play",
+        "publish a recording as ROS 2 topics, in real time or faster (.venv-ros)",
+    ),
     "config": ("farlio.commands.config", "print every parameter with its default and meaning (YAML)"),
     "info": ("farlio.commands.info", "print the build (CUDA backend, devices) and version"),
 }
@@ -38,8 +43,19 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+#: where ROS 2 arguments start (`farlio ros2 --ros-args -p name:=value`): the rest goes to rclpy
+ROS_ARGS = "--ros-args"
+ROS_COMMANDS = ("ros2", "ros2-play")
+
+
 def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+    argv = list(sys.argv[1:] if argv is None else argv)
+    ros_args = argv[argv.index(ROS_ARGS) :] if ROS_ARGS in argv else []
+    args = build_parser().parse_args(argv[: len(argv) - len(ros_args)])
+    if ros_args and args.command not in ROS_COMMANDS:
+        print(f"farlio {args.command}: error: {ROS_ARGS} is for {' and '.join(ROS_COMMANDS)}", file=sys.stderr)
+        return 2
+    args.ros_args = ros_args
     try:
         return int(importlib.import_module(args._module).run(args) or 0)
     except KeyboardInterrupt:

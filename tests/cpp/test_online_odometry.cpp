@@ -9,7 +9,9 @@
 #include <limits>
 #include <mutex>
 #include <thread>
+#include <unordered_set>
 
+#include "farlio/map/voxel_key.hpp"
 #include "farlio/pipeline/odometry.hpp"
 #include "farlio/pipeline/online_odometry.hpp"
 #include "farlio/sim/sequence_generator.hpp"
@@ -190,6 +192,47 @@ TEST(OnlineOdometry, RealTimeThreadsKeepTheOutputsConsistent) {
   }
   for (std::size_t i = 1; i < samples.size(); ++i) EXPECT_EQ(samples[i].stamp_ns - samples[i - 1].stamp_ns, 10'000'000);
   for (const auto& s : samples) EXPECT_TRUE(s.body_pose.translation().allFinite());
+}
+
+TEST(OnlineOdometry, RegisteredPointsAreTheScanInsertedIntoTheMap) {
+  // LiDAR-only, scan after scan: every processed frame carries its kept points in the world
+  // frame, and each of the last frame's points falls into a voxel of the submap snapshot (it was
+  // just inserted there; nothing is removed near the sensor).
+  const Recording& rec = recording();
+  Config config = deterministic_config();
+  config.map.auto_voxel_size = false;  // the voxel size the test maps points with
+  constexpr std::size_t kScans = 4;
+  std::vector<OdometryFrame> frames;
+  std::mutex frames_mutex;
+  OnlineOdometry online(
+      config, rec.T_imu_lidar, rec.gravity_m_s2, {},
+      [&](const OdometryFrame& f) {
+        std::lock_guard lock(frames_mutex);
+        frames.push_back(f);
+      },
+      /*keep_registered_points=*/true);
+  EXPECT_TRUE(online.map_snapshot().voxel_keys.empty());  // before the first scan
+  for (std::size_t i = 0; i < kScans; ++i) {
+    ASSERT_TRUE(online.add_scan(rec.scans[i]));
+    online.wait_idle();
+  }
+  const map::MapSnapshot snapshot = online.map_snapshot();
+  online.stop();
+  ASSERT_EQ(frames.size(), kScans);
+  for (const auto& f : frames) {
+    EXPECT_EQ(f.registered_points.size(), f.scan.kept_points);
+    EXPECT_GT(f.registered_points.size(), 1000u);
+  }
+  std::unordered_set<std::uint64_t> occupied;
+  for (std::size_t v = 0; v < snapshot.voxel_keys.size(); ++v) {
+    if (snapshot.voxel_counts[v] > 0) occupied.insert(snapshot.voxel_keys[v]);
+  }
+  const auto inv_voxel = static_cast<float>(1.0 / config.map.voxel_size_m);
+  std::size_t outside = 0;
+  for (const auto& p : frames.back().registered_points) {
+    outside += occupied.count(map::pack_key(map::voxel_of(p, inv_voxel))) == 0 ? 1 : 0;
+  }
+  EXPECT_EQ(outside, 0u);
 }
 
 TEST(Replay, ResultsArrivingAfterTheLastImuSampleAreNoImuGap) {

@@ -25,9 +25,7 @@ LAUNCH_ROTATION_SLACK_DEG = 0.01
 
 def _accuracy(seq, out, fused: bool) -> dict[str, float]:
     config = load_config(None, [] if fused else ["fusion.enabled=false"])
-    s = run_dataset(
-        open_dataset(seq), out, config, progress=False, plot=False, options=replay_options("fixed", 0.02)
-    )
+    s = run_dataset(open_dataset(seq), out, config, progress=False, plot=False, options=replay_options("fixed", 0.02))
     a = s["accuracy"]
     return {
         "ape_m": a["ape"]["translation_m"]["rmse"],

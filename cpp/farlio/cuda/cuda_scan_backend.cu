@@ -151,6 +151,11 @@ class CudaScanBackend final : public pipeline::ScanBackend {
   [[nodiscard]] std::size_t map_voxels() const override { return map_.num_voxels(); }
   [[nodiscard]] std::size_t map_points() const override { return map_.num_points(); }
   [[nodiscard]] map::MapSnapshot map_snapshot() const override { return map_.snapshot(); }
+  [[nodiscard]] std::vector<Eigen::Vector3f> frame_points() const override {
+    std::vector<Eigen::Vector3f> out(frame_size_);
+    frame_.download(out.data(), frame_size_, executor_.stream());
+    return out;
+  }
 
   [[nodiscard]] std::size_t memory_bytes() const override {
     return executor_.memory_bytes() + algorithms_.memory_bytes() + scratch_.memory_bytes() + map_.memory_bytes() +

@@ -24,6 +24,7 @@ class CpuScanBackend final : public ScanBackend {
   [[nodiscard]] std::size_t map_points() const override { return map_.num_points(); }
   [[nodiscard]] std::size_t memory_bytes() const override { return map_.memory_bytes(); }
   [[nodiscard]] map::MapSnapshot map_snapshot() const override { return map_.snapshot(); }
+  [[nodiscard]] std::vector<Eigen::Vector3f> frame_points() const override { return frame_; }
 
  private:
   Config config_;

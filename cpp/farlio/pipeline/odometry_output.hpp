@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "farlio/core/se3.hpp"
 #include "farlio/pipeline/scan_pipeline.hpp"
@@ -25,6 +26,9 @@ struct OdometryFrame {
   bool guess_from_fusion = false;  ///< initial guess and undistortion came from the fusion
   /// How well the registration constrained the body pose (registered scans only).
   std::optional<registration::Degeneracy> degeneracy;
+  /// The registered scan: the kept (undistorted, downsampled) points in the world frame at the
+  /// registered pose. Filled only by the online odometry when asked to (keep_registered_points).
+  std::vector<Eigen::Vector3f> registered_points;
 };
 
 /// One sample of the 100 Hz odometry output.

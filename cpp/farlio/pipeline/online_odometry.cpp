@@ -6,13 +6,15 @@
 namespace farlio::pipeline {
 
 OnlineOdometry::OnlineOdometry(const Config& config, const SE3& T_imu_lidar, double gravity_m_s2,
-                               OdometryCallback on_odometry, FrameCallback on_frame)
+                               OdometryCallback on_odometry, FrameCallback on_frame, bool keep_registered_points)
     : config_(validated(config)),
       T_imu_lidar_(T_imu_lidar),
       T_lidar_imu_(T_imu_lidar.inverse()),
+      keep_registered_points_(keep_registered_points),
       on_odometry_(std::move(on_odometry)),
       on_frame_(std::move(on_frame)),
-      driver_(config, gravity_m_s2, T_imu_lidar, config.fusion.enabled) {
+      driver_(config, gravity_m_s2, T_imu_lidar, config.fusion.enabled),
+      pipeline_(config_) {
   worker_ = std::thread([this] { worker_loop(); });
 }
 
@@ -85,20 +87,28 @@ void OnlineOdometry::worker_loop() {
 OdometryFrame OnlineOdometry::process(const Scan& scan) {
   OdometryFrame out;
   ScanPrior prior;
+  std::unique_lock pipeline_lock(pipeline_mutex_);
   {
     std::lock_guard lock(state_mutex_);
     if (!mode_decided_) {  // the first scan fixes the mode and the start pose
       mode_decided_ = true;
       if (!driver_.has_imu()) driver_.stop_fusion();
-      pipeline_.emplace(config_, driver_.start_pose(scan.end_stamp_ns) * T_imu_lidar_);
+      pipeline_.reset_initial_pose(driver_.start_pose(scan.end_stamp_ns) * T_imu_lidar_);
     }
     prior = driver_.prior(scan);
     out.started_ns = driver_.inertial() ? driver_.clock_ns() : scan.end_stamp_ns;
   }
   out.guess_from_fusion = prior.guess.has_value();
-  out.scan = pipeline_->process(scan, prior.guess, prior.motion);
+  out.scan = pipeline_.process(scan, prior.guess, prior.motion);
   out.processed = true;
   out.body_pose = out.scan.pose * T_lidar_imu_;
+  if (keep_registered_points_) {
+    out.registered_points = pipeline_.backend().frame_points();
+    const Eigen::Matrix3f R = out.scan.pose.rotation().cast<float>();
+    const Eigen::Vector3f t = out.scan.pose.translation().cast<float>();
+    for (auto& p : out.registered_points) p = R * p + t;
+  }
+  pipeline_lock.unlock();
 
   std::lock_guard lock(state_mutex_);
   driver_.link(scan, out);
@@ -118,6 +128,15 @@ std::optional<fusion::FusionStats> OnlineOdometry::fusion_stats() const {
   if (!mode_decided_) return std::nullopt;
   return driver_.stats();
 }
+
+map::MapSnapshot OnlineOdometry::map_snapshot() const {
+  std::lock_guard lock(pipeline_mutex_);
+  return pipeline_.frames() > 0 ? pipeline_.backend().map_snapshot() : map::MapSnapshot{};
+}
+
+Device OnlineOdometry::device() const { return pipeline_.backend().device(); }
+
+const std::string& OnlineOdometry::device_message() const { return pipeline_.device_message(); }
 
 std::size_t OnlineOdometry::scans_dropped_busy() const {
   std::lock_guard lock(state_mutex_);

@@ -11,6 +11,8 @@
 // A scan that arrives while the worker is still busy is dropped (as in the paper). Without an
 // IMU sample before the first scan, or with fusion.enabled off, the odometry is LiDAR-only and
 // on_odometry is not called.
+// With keep_registered_points, every processed frame carries its registered scan (world frame),
+// for a live view; map_snapshot() copies the submap between two scans.
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
@@ -22,6 +24,7 @@
 #include "farlio/core/config.hpp"
 #include "farlio/core/types.hpp"
 #include "farlio/fusion/sensor_fusion.hpp"
+#include "farlio/map/map_snapshot.hpp"
 #include "farlio/pipeline/fusion_driver.hpp"
 #include "farlio/pipeline/odometry_output.hpp"
 #include "farlio/pipeline/scan_pipeline.hpp"
@@ -34,7 +37,7 @@ class OnlineOdometry {
   using FrameCallback = std::function<void(const OdometryFrame&)>;
 
   OnlineOdometry(const Config& config, const SE3& T_imu_lidar, double gravity_m_s2, OdometryCallback on_odometry = {},
-                 FrameCallback on_frame = {});
+                 FrameCallback on_frame = {}, bool keep_registered_points = false);
   ~OnlineOdometry();
   OnlineOdometry(const OnlineOdometry&) = delete;
   OnlineOdometry& operator=(const OnlineOdometry&) = delete;
@@ -53,6 +56,13 @@ class OnlineOdometry {
   [[nodiscard]] std::optional<fusion::FusionStats> fusion_stats() const;
   /// Scans dropped because the worker was busy.
   [[nodiscard]] std::size_t scans_dropped_busy() const;
+  /// The backend the scan pipeline runs on (chosen at construction) and why auto fell back to the
+  /// CPU ('' when it did not).
+  [[nodiscard]] Device device() const;
+  [[nodiscard]] const std::string& device_message() const;
+  /// A host copy of the submap (world frame); empty before the first scan. Waits for the scan in
+  /// progress, if any.
+  [[nodiscard]] map::MapSnapshot map_snapshot() const;
 
  private:
   void worker_loop();
@@ -60,6 +70,7 @@ class OnlineOdometry {
 
   const Config config_;
   const SE3 T_imu_lidar_, T_lidar_imu_;
+  const bool keep_registered_points_;
   OdometryCallback on_odometry_;
   FrameCallback on_frame_;
 
@@ -76,8 +87,9 @@ class OnlineOdometry {
   std::condition_variable queue_cv_;
   std::optional<Scan> pending_;
   bool busy_ = false, stopping_ = false;
-  std::optional<ScanPipeline> pipeline_;  // worker only; created at the first scan
-  std::thread worker_;
+  mutable std::mutex pipeline_mutex_;  // held by the worker while it processes, and by map_snapshot
+  ScanPipeline pipeline_;              // its backend made at construction; the start pose set at the first scan
+  std::thread worker_;                 // last: started when everything above is constructed
 };
 
 }  // namespace farlio::pipeline

@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "farlio/core/config.hpp"
 #include "farlio/core/device.hpp"
@@ -50,6 +51,9 @@ class ScanBackend {
   [[nodiscard]] virtual std::size_t memory_bytes() const = 0;
   /// A host copy of the submap.
   [[nodiscard]] virtual map::MapSnapshot map_snapshot() const = 0;
+  /// A host copy of the last preprocessed frame: the kept points, undistorted, in the sensor
+  /// frame at the scan end (what update_map inserts).
+  [[nodiscard]] virtual std::vector<Eigen::Vector3f> frame_points() const = 0;
   /// Replaces the wall-clock stage times of the frame just processed by device-measured ones;
   /// false (and `t` untouched) on a backend without device timers.
   virtual bool device_stage_times(FrameTimings& t) {

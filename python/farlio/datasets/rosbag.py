@@ -3,9 +3,10 @@ with the `rosbags` package (pure Python; no ROS installation).
 
 Topics: with exactly one sensor_msgs/PointCloud2 and at most one sensor_msgs/Imu topic they are
 chosen automatically; otherwise `LoadOptions.lidar_topics` / `imu_topic` name them (the error
-lists what the bag has). Several LiDAR topics are merged into one scan per period of the first:
-the points of the others whose times fall into that period, moved into the first LiDAR's frame
-with their extrinsics, each point keeping its own time and a sensor id (the topic's index).
+lists what the bag has). Several LiDAR topics are merged into one scan per period of the first
+(lidar_merge.py): the points of the others whose times fall into that period, moved into the
+first LiDAR's frame with their extrinsics, each point keeping its own time and a sensor id (the
+topic's index).
 
 Extrinsics: `--calib` file first, else /tf_static (the chain from the IMU message frame to each
 cloud's frame), else identity with a warning. Scans are read in one sequential pass (a backward
@@ -22,11 +23,11 @@ from typing import Any
 import numpy as np
 
 import farlio
-from farlio._core import NS_PER_S
 
 from .base import Dataset, LoadOptions
 from .calib import CalibFile, se3_from_quaternion
-from .pointcloud2 import MAX_SCAN_SPAN_S, TIME_FIELDS, Cloud, CloudError, decode, field_names, stamp_ns, time_field_of
+from .lidar_merge import TimedClouds, assemble, caught_up, scan_interval
+from .pointcloud2 import TIME_FIELDS, Cloud, CloudError, decode, field_names, stamp_ns, time_field_of
 
 POINTCLOUD2 = "sensor_msgs/msg/PointCloud2"
 IMU = "sensor_msgs/msg/Imu"
@@ -37,9 +38,6 @@ ROS2_SUFFIXES = (".db3", ".mcap")
 ROS2_METADATA = "metadata.yaml"
 #: ouster-ros packet messages: such bags are read by the Ouster dataloader (datasets/ouster.py)
 OUSTER_PACKET_TYPES = ("ouster_ros/msg/PacketMsg", "ouster_sensor_msgs/msg/PacketMsg", "ouster_msgs/msg/PacketMsg")
-#: scan period used when a lone scan has no neighbour and no per-point times
-DEFAULT_PERIOD_NS = 100_000_000
-MAX_SCAN_SPAN_NS = int(MAX_SCAN_SPAN_S * NS_PER_S)
 
 
 class BagError(RuntimeError):
@@ -313,7 +311,7 @@ class RosBag(Dataset):
     def _scans(self) -> Iterator[farlio.Scan | Exception]:
         clouds = self._clouds()
         refs: deque[Cloud | CloudError] = deque()
-        others: list[deque[tuple[Cloud, np.ndarray]]] = [deque() for _ in self.lidar_topics[1:]]
+        others: list[TimedClouds] = [deque() for _ in self.lidar_topics[1:]]
         done = False
 
         def pull() -> None:
@@ -337,76 +335,8 @@ class RosBag(Dataset):
                 yield cur
                 continue
             nxt = next((c for c in refs if isinstance(c, Cloud)), None)
-            start, end = self._interval(cur, nxt, prev)
-            while others and not done and any(not q or q[-1][1].max(initial=0) < end for q in others):
+            start, end = scan_interval(cur, nxt, prev)
+            while others and not done and not caught_up(others, end):
                 pull()
-            yield self._assemble(cur, start, end, others)
+            yield assemble(cur, start, end, others, self._extrinsics, self._has_time)
             prev = (start, end)
-
-    @staticmethod
-    def _interval(cur: Cloud, nxt: Cloud | None, prev: tuple[int, int] | None) -> tuple[int, int]:
-        """Scan start and end: the header stamp is one of them, the neighbouring header the other."""
-
-        def plausible(d: int) -> bool:
-            return 0 < d <= MAX_SCAN_SPAN_NS
-
-        prev_period = prev[1] - prev[0] if prev else None
-        next_period = (
-            nxt.stamp_ns - cur.stamp_ns if nxt is not None and plausible(nxt.stamp_ns - cur.stamp_ns) else None
-        )
-        offsets = cur.offset_s
-        if cur.header_is_end:
-            end = cur.stamp_ns
-            if prev is not None and plausible(end - prev[1]):
-                return prev[1], end
-            period = (
-                next_period
-                or prev_period
-                or (
-                    int(round(-offsets.min() * NS_PER_S)) if offsets is not None and offsets.size else DEFAULT_PERIOD_NS
-                )
-            )
-            return end - period, end
-        start = cur.stamp_ns
-        period = (
-            next_period
-            or prev_period
-            or (int(round(offsets.max() * NS_PER_S)) if offsets is not None and offsets.size else DEFAULT_PERIOD_NS)
-        )
-        return start, start + max(period, 1)
-
-    def _assemble(self, cur: Cloud, start: int, end: int, others: list[deque[tuple[Cloud, np.ndarray]]]) -> farlio.Scan:
-        shift_s = (cur.stamp_ns - start) / NS_PER_S
-        pts = [cur.points]
-        times = [None if cur.offset_s is None else cur.offset_s + shift_s]
-        inten = [cur.intensity if cur.intensity is not None else np.zeros(len(cur.points), np.float32)]
-        ids = [np.zeros(len(cur.points), np.uint8)]
-        T_lidar_imu = self._extrinsics[0].inverse()
-        for k, q in enumerate(others, start=1):
-            m = (T_lidar_imu * self._extrinsics[k]).matrix()
-            for cloud, abs_ns in q:
-                sel = (abs_ns >= start) & (abs_ns < end)
-                if not sel.any():
-                    continue
-                pts.append(cloud.points[sel] @ m[:3, :3].T.astype(np.float32) + m[:3, 3].astype(np.float32))
-                times.append((abs_ns[sel] - start) / NS_PER_S)
-                inten.append(
-                    cloud.intensity[sel] if cloud.intensity is not None else np.zeros(int(sel.sum()), np.float32)
-                )
-                ids.append(np.full(int(sel.sum()), k, np.uint8))
-            while q and q[0][1].max(initial=0) < end:
-                q.popleft()
-
-        def joined(parts: list[np.ndarray]) -> np.ndarray:
-            return parts[0] if len(parts) == 1 else np.concatenate(parts)
-
-        points = np.ascontiguousarray(joined(pts), dtype=np.float32)
-        time_s = joined(times).astype(np.float32) if self._has_time and all(t is not None for t in times) else None
-        return farlio.Scan(
-            points,
-            time_s=time_s,
-            intensity=np.ascontiguousarray(joined(inten), dtype=np.float32),
-            start_stamp_ns=start,
-            end_stamp_ns=end,
-            sensor_id=np.concatenate(ids) if len(self.lidar_topics) > 1 else None,
-        )

@@ -6,7 +6,6 @@ farlio dataset (e.g. a sequence folder) into a bag.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -15,35 +14,12 @@ import numpy as np
 import farlio
 from farlio._core import NS_PER_S
 
+from .pointcloud2_encode import encode
+
 STORAGES = ("ros1", "sqlite3", "mcap")
-#: sensor_msgs/PointField datatype codes
-FLOAT32, FLOAT64, UINT32 = 7, 8, 6
 ROS2_BAG_VERSION = 9
 TFMESSAGE = "tf2_msgs/msg/TFMessage"
 TFMESSAGE_DEFINITION = "geometry_msgs/TransformStamped[] transforms"
-
-
-@dataclass(frozen=True)
-class TimeConvention:
-    """How a driver writes per-point times: field name, numpy type, unit (ns per unit), whether
-    values are absolute times, and whether the header stamp is the scan end."""
-
-    field: str | None
-    dtype: str
-    ns_per_unit: int
-    absolute: bool
-    header_is_end: bool
-
-
-CONVENTIONS = {
-    "ouster": TimeConvention("t", "u4", 1, False, False),
-    "velodyne": TimeConvention("time", "f4", NS_PER_S, False, True),
-    "hesai": TimeConvention("timestamp", "f8", NS_PER_S, True, False),
-    "livox": TimeConvention("offset_time", "u4", 1, False, False),
-    "robosense": TimeConvention("timestamp", "f8", NS_PER_S, True, True),
-    "none": TimeConvention(None, "", 0, False, False),
-}
-_POINTFIELD_CODES = {"f4": FLOAT32, "f8": FLOAT64, "u4": UINT32}
 
 
 class BagWriter:
@@ -107,51 +83,19 @@ class BagWriter:
     ) -> None:
         """One PointCloud2; time_s: per-point time in s since start_ns. `padding` bytes are left
         unnamed at the end of every point (as drivers do for alignment)."""
-        conv = CONVENTIONS[convention]
-        header_ns = end_ns if conv.header_is_end else start_ns
-        names = [("x", "f4"), ("y", "f4"), ("z", "f4")]
-        if intensity is not None:
-            names.append(("intensity", "f4"))
-        if conv.field is not None and time_s is not None:
-            names.append((conv.field, conv.dtype))
-        offsets, off = [], 0
-        for _, t in names:
-            offsets.append(off)
-            off += np.dtype(t).itemsize
-        dtype = np.dtype(
-            {
-                "names": [n for n, _ in names],
-                "formats": [t for _, t in names],
-                "offsets": offsets,
-                "itemsize": off + padding,
-            }
-        )
-        arr = np.zeros(len(points), dtype=dtype)
-        for k, c in enumerate("xyz"):
-            arr[c] = points[:, k]
-        if intensity is not None:
-            arr["intensity"] = intensity
-        if conv.field is not None and time_s is not None:
-            t = np.asarray(time_s, dtype=np.float64)
-            if conv.absolute:
-                arr[conv.field] = (start_ns + np.round(t * NS_PER_S)) / conv.ns_per_unit
-            else:
-                rel_ns = np.round(t * NS_PER_S) + (start_ns - header_ns)
-                arr[conv.field] = rel_ns / conv.ns_per_unit if conv.ns_per_unit > 1 else np.round(rel_ns)
+        enc = encode(points, time_s, intensity, start_ns, end_ns, convention, padding)
         field_type = self._type("sensor_msgs/msg/PointField")
-        fields = [
-            field_type(name=n, offset=o, datatype=_POINTFIELD_CODES[t], count=1) for (n, t), o in zip(names, offsets)
-        ]
+        fields = [field_type(name=n, offset=o, datatype=d, count=1) for n, o, d in enc.fields]
         msgtype = "sensor_msgs/msg/PointCloud2"
         msg = self._type(msgtype)(
-            header=self._header(header_ns, frame),
+            header=self._header(enc.header_ns, frame),
             height=1,
-            width=len(points),
+            width=enc.width,
             fields=fields,
             is_bigendian=False,
-            point_step=dtype.itemsize,
-            row_step=dtype.itemsize * len(points),
-            data=arr.view(np.uint8).reshape(-1),
+            point_step=enc.point_step,
+            row_step=len(enc.data),
+            data=enc.data,
             is_dense=True,
         )
         self._write(topic, msgtype, end_ns, msg)
