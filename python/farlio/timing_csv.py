@@ -14,6 +14,8 @@ MS_PER_S = 1e3
 NS_PER_MS = NS_PER_S / MS_PER_S
 #: timing.csv's stage_clock: the stage times are wall clock (CPU) or CUDA events (GPU timeline)
 STAGE_CLOCKS = {False: "wall", True: "cuda_events"}
+#: how well the registration constrained the pose (empty for a scan that was not registered)
+DEGENERACY_COLUMNS = ["translation_std_max_m", "translation_weak_axis", "rotation_std_max_rad", "degenerate_directions"]
 TIMING_COLUMNS = [
     "frame",
     "stamp_ns",
@@ -37,11 +39,8 @@ TIMING_COLUMNS = [
     "fused",
     "guess_from_fusion",
     "latency_ms",
+    *DEGENERACY_COLUMNS,
     "drop_reason",
-    "translation_std_max_m",
-    "translation_weak_axis",
-    "rotation_std_max_rad",
-    "degenerate_directions",
 ]
 
 
@@ -78,8 +77,8 @@ def timing_row(index: int, scan: Any, frame: Any) -> dict[str, Any]:
         "fused": int(frame.fused),
         "guess_from_fusion": int(frame.guess_from_fusion),
         "latency_ms": f"{(frame.available_ns - frame.started_ns) / NS_PER_MS:.3f}",
-        "drop_reason": frame.drop_reason,
         **_degeneracy_fields(frame.degeneracy),
+        "drop_reason": frame.drop_reason,
     }
 
 
@@ -87,7 +86,7 @@ def _degeneracy_fields(d: Any) -> dict[str, Any]:
     """The registration's largest translation std with its body-frame direction, its largest
     rotation std, and how many directions exceed the degeneracy thresholds (docs/fusion.md)."""
     if d is None:
-        return {}
+        return dict.fromkeys(DEGENERACY_COLUMNS, "")
     axis = d.translation_axes[:, 0]
     axis = axis if axis[abs(axis).argmax()] >= 0 else -axis  # the sign is arbitrary: largest component positive
     return {

@@ -14,7 +14,7 @@ core = pytest.importorskip("farlio._core")
 from farlio.datasets import open_dataset  # noqa: E402
 from farlio.runner import replay_options, run_dataset  # noqa: E402
 from farlio.simulation import generate  # noqa: E402
-from farlio.timing_csv import TIMING_COLUMNS, TimingCsv, timing_row  # noqa: E402
+from farlio.timing_csv import DEGENERACY_COLUMNS, TIMING_COLUMNS, TimingCsv, timing_row  # noqa: E402
 
 SIM_DURATION_S = 1.0
 SUMMARY_KEYS = [
@@ -25,6 +25,7 @@ SUMMARY_KEYS = [
     "skipped",
     "dropped",
     "registered",
+    "degenerate",
     "converged_fraction",
     "latency_ms",
     "wall_s",
@@ -69,7 +70,10 @@ def test_every_timing_row_has_the_header_columns(run):
     for row in rows:
         assert len(row) == len(header)
         filled = dict(zip(header, row))
-        assert all(filled[c] != "" for c in TIMING_COLUMNS if c != "drop_reason"), row
+        # the degeneracy columns are empty only for a scan that was not registered (the first)
+        optional = ["drop_reason"] + (DEGENERACY_COLUMNS if filled["registered"] == "0" else [])
+        assert all(filled[c] != "" for c in TIMING_COLUMNS if c not in optional), row
+    assert sum(row[header.index("translation_std_max_m")] != "" for row in rows) == summary["registered"]
 
 
 def test_a_processed_frame_fills_every_column_in_order(sequence):
