@@ -17,8 +17,8 @@ constexpr double kJacobianTol = 1e-5;  // absolute tolerance of a Jacobian entry
 constexpr int kRandomCases = 50;
 
 StateVector true_state(const test::TestTrajectory& traj, double t) {
-  StateVector x;
-  x << traj.at(t).p, traj.rpy(t), traj.velocity_body(t);
+  StateVector x = StateVector::Zero();  // zero biases
+  x.head<9>() << traj.at(t).p, traj.rpy(t), traj.velocity_body(t);
   return x;
 }
 InputVector true_input(const test::TestTrajectory& traj, double t) {
