@@ -6,6 +6,9 @@ against the exact ground truth, next to LiDAR-only on the same data (docs/fusion
 Each variant isolates one part of the fusion:
   lidar_only      no fusion (the reference the LIO must not be worse than)
   lio             the defaults
+  paper_filter    the filter before issue 11: no bias states, the fixed LiDAR noise (the other
+                  variants run on it with --set fusion.estimate_imu_bias=false
+                  fusion.lidar_information_from_registration=false)
   ideal_imu       the same scans, the IMU of the noise-free generator (no noise, no bias)
   ideal_gyro      ideal gyro, noisy accelerometer
   ideal_accel     noisy gyro, ideal accelerometer
@@ -22,6 +25,7 @@ odometry (deg).
 
   python scripts/diagnose_fusion.py --profile racetrack --duration 30 --seeds 1 2 \
       [--variants lio lidar_only ...] [--set name=value ...]
+  python scripts/diagnose_fusion.py --profile urban --duration 10 --seeds 1 --covariance-scale
 """
 
 from __future__ import annotations
@@ -37,14 +41,18 @@ import farlio  # noqa: F401  (loads the extension)
 import numpy as np
 from farlio import _core
 from farlio.evaluation import make_options
+from farlio.runner import replay_options
 from farlio.simulation import generate
 
 FIXED_LATENCY_S = 0.02  # the accuracy tables' latency model (scripts/measure_accuracy.py)
 
+# the filter before issue 11: no bias states, the fixed LiDAR noise
+PAPER_FILTER = {"fusion.estimate_imu_bias": "false", "fusion.lidar_information_from_registration": "false"}
 VARIANTS: dict[str, tuple[dict[str, str], str]] = {
     # name: (config overrides, IMU source)
     "lidar_only": ({"fusion.enabled": "false"}, "noisy"),
     "lio": ({}, "noisy"),
+    "paper_filter": (PAPER_FILTER, "noisy"),
     "ideal_imu": ({}, "ideal"),
     "ideal_gyro": ({}, "ideal_gyro"),
     "ideal_accel": ({}, "ideal_accel"),
@@ -64,6 +72,7 @@ def rotation_angle_deg(a, b) -> float:
 
 
 def mixed_imu(noisy: list, ideal: list, source: str) -> list:
+    """The IMU of a variant: noisy, ideal, or one sensor ideal and the other noisy."""
     if source == "noisy":
         return noisy
     if source == "ideal":
@@ -72,10 +81,8 @@ def mixed_imu(noisy: list, ideal: list, source: str) -> list:
     for n, i in zip(noisy, ideal, strict=True):
         s = _core.ImuSample()
         s.stamp_ns = n.stamp_ns
-        s.gyro_rad_s = i.gyro_rad_s if source == "ideal_gyro" else n.gyro_rad_s
-        s.accel_m_s2 = i.accel_m_s2 if source == "ideal_gyro" else n.accel_m_s2
-        if source == "ideal_accel":
-            s.gyro_rad_s, s.accel_m_s2 = n.gyro_rad_s, i.accel_m_s2
+        s.gyro_rad_s = (i if source == "ideal_gyro" else n).gyro_rad_s
+        s.accel_m_s2 = (i if source == "ideal_accel" else n).accel_m_s2
         out.append(s)
     return out
 
@@ -109,11 +116,8 @@ def run_variant(seq: Sequence, overrides: dict[str, str], imu_source: str) -> di
     config = _core.Config()
     for name, value in overrides.items():
         config.set(name, value)
-    options = _core.ReplayOptions()
-    options.latency = _core.LatencyModel.Fixed
-    options.fixed_latency_s = FIXED_LATENCY_S
     imu = mixed_imu(seq.imu, seq.ideal_imu, imu_source) if config.get("fusion.enabled") else []
-    odo = _core.Odometry(config, seq.T_imu_lidar, seq.gravity_m_s2, imu, options)
+    odo = _core.Odometry(config, seq.T_imu_lidar, seq.gravity_m_s2, imu, replay_options("fixed", FIXED_LATENCY_S))
     T_lidar_imu = seq.T_imu_lidar.inverse()
     scans, odometry = _core.Trajectory(), _core.Trajectory()
     guess_errors = []
@@ -149,6 +153,29 @@ def run_variant(seq: Sequence, overrides: dict[str, str], imu_source: str) -> di
     return row
 
 
+def covariance_scale(seq: Sequence) -> tuple[float, float]:
+    """registration.covariance_scale as measured by the data (LiDAR-only): the mean and median over
+    consecutive scans of e^T (H_k^-1 + H_k-1^-1)^-1 e / 6, e the error of the registered relative
+    pose against the truth (sensor frame, [t; r])."""
+    config = _core.Config()
+    config.set("fusion.enabled", "false")
+    odo = _core.Odometry(config, seq.T_imu_lidar, seq.gravity_m_s2, [], replay_options("fixed", FIXED_LATENCY_S))
+    truth = [p * seq.T_imu_lidar for p in poses(seq.gt_scans)]
+    previous, nees = None, []
+    for scan, true_pose in zip(seq.scans, truth, strict=True):
+        fr = odo.process(scan)
+        if not (fr.processed and fr.scan.registered):
+            previous = None
+            continue
+        H = np.asarray(fr.scan.hessian)
+        if previous is not None:
+            H_prev, pose_prev, true_prev = previous
+            e = np.asarray(((true_prev.inverse() * true_pose).inverse() * (pose_prev.inverse() * fr.scan.pose)).log())
+            nees.append(e @ np.linalg.solve(np.linalg.inv(H) + np.linalg.inv(H_prev), e) / 6.0)
+        previous = (H, fr.scan.pose, true_pose)
+    return float(np.mean(nees)), float(np.median(nees))
+
+
 def main() -> int:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--profile", default="racetrack", help="generator profile")
@@ -158,9 +185,19 @@ def main() -> int:
     p.add_argument(
         "--cache", type=Path, default=Path(tempfile.gettempdir()) / "farlio_diagnose", help="generated sequences"
     )
+    p.add_argument(
+        "--covariance-scale",
+        action="store_true",
+        help="instead of the variants: measure registration.covariance_scale (LiDAR-only relative-pose NEES)",
+    )
     p.add_argument("--set", nargs="*", default=[], metavar="NAME=VALUE", help="config fields for every variant")
     args = p.parse_args()
     common = dict(item.split("=", 1) for item in args.set)
+    if args.covariance_scale:
+        for seed in args.seeds:
+            mean, median = covariance_scale(Sequence(args.profile, seed, args.duration, args.cache))
+            print(f"{args.profile} seed {seed}: covariance_scale mean {mean:.2e}, median {median:.2e}")
+        return 0
     print(
         f"{'seed':>4} {'variant':<14} {'APE m':>8} {'rot deg':>8} {'RPE %':>7} {'drift m':>8} "
         f"{'guess deg':>9} {'odom deg':>8}"

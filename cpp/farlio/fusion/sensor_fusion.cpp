@@ -210,7 +210,8 @@ LidarUpdateResult SensorFusion::add_lidar(std::int64_t measured_at_ns, const SE3
   }
   std::vector<LidarGroup> groups;
   const Eigen::Vector3d angles = euler_from_rotation(body_pose.rotation());
-  if (body_covariance && config_.lidar_information_from_registration) {
+  const bool registration_covariance = body_covariance && config_.lidar_information_from_registration;
+  if (registration_covariance) {
     Vec6d z;
     z << body_pose.translation(), angles;
     groups.push_back({MeasurementKind::kPose, z, pose_measurement_covariance(*body_covariance, body_pose, config_)});
@@ -220,9 +221,10 @@ LidarUpdateResult SensorFusion::add_lidar(std::int64_t measured_at_ns, const SE3
     groups.push_back({MeasurementKind::kOrientation, angles, R.bottomRightCorner<3, 3>()});
   }
   if (use_velocity) {
-    groups.push_back(
-        {MeasurementKind::kVelocity, body_velocity_m_s,
-         velocity_covariance.value_or(Eigen::Matrix3d::Identity() * square(config_.lidar_velocity_std_m_s))});
+    groups.push_back({MeasurementKind::kVelocity, body_velocity_m_s,
+                      registration_covariance && velocity_covariance
+                          ? *velocity_covariance
+                          : Eigen::Matrix3d(Eigen::Matrix3d::Identity() * square(config_.lidar_velocity_std_m_s))});
   }
   const int injections = spread_steps(measured_at_ns);
   last_lidar_ns_ = measured_at_ns;

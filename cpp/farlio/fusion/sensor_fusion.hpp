@@ -68,7 +68,8 @@ class SensorFusion {
   /// body_covariance: the registration's covariance of a right perturbation [t; r] of body_pose
   /// (registration/degeneracy.hpp); fused as one pose group when given and
   /// lidar_information_from_registration, else the fixed lidar_*_std apply. velocity_covariance:
-  /// of the body velocity (lidar_measurement.hpp); empty: lidar_velocity_std_m_s.
+  /// of the body velocity (lidar_measurement.hpp), used under the same condition; else
+  /// lidar_velocity_std_m_s.
   LidarUpdateResult add_lidar(std::int64_t measured_at_ns, const SE3& body_pose,
                               const Eigen::Vector3d& body_velocity_m_s, bool use_velocity,
                               const std::optional<Mat6d>& body_covariance = std::nullopt,

@@ -1,0 +1,115 @@
+// The registration's covariance in the body frame, its degeneracy, and the LiDAR measurement the
+// fusion builds from it (registration/degeneracy.hpp, fusion/lidar_measurement.hpp), checked
+// against brute force: perturbations applied to the poses themselves.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "farlio/core/config.hpp"
+#include "farlio/core/se3.hpp"
+#include "farlio/fusion/euler.hpp"
+#include "farlio/fusion/lidar_measurement.hpp"
+#include "farlio/registration/degeneracy.hpp"
+
+namespace farlio {
+namespace {
+
+constexpr double kStep = 1e-6;  // finite-difference step (m, rad)
+
+SE3 random_pose(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Vec6d xi;
+  for (int i = 0; i < 6; ++i) xi(i) = u(rng);
+  return SE3::exp(xi);
+}
+
+TEST(Degeneracy, AdjointMovesARightPerturbationThroughAnExtrinsic) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-0.01, 0.01);
+  for (int c = 0; c < 20; ++c) {
+    const SE3 T_world_sensor = random_pose(rng), T_body_sensor = random_pose(rng);
+    Vec6d xi;
+    for (int i = 0; i < 6; ++i) xi(i) = u(rng);
+    // (T_ws exp(xi)) T_sb == (T_ws T_sb) exp(adjoint(T_bs) xi)
+    const SE3 T_sb = T_body_sensor.inverse();
+    const SE3 moved = T_world_sensor * SE3::exp(xi) * T_sb;
+    const SE3 predicted = T_world_sensor * T_sb * SE3::exp(adjoint(T_body_sensor) * xi);
+    EXPECT_LT((moved.inverse() * predicted).log().norm(), 1e-12) << c;
+  }
+}
+
+TEST(Degeneracy, BodyInformationGivesTheSameCostForTheSameMotion) {
+  std::mt19937 rng(5);
+  const SE3 T_body_sensor = random_pose(rng);
+  Mat6d A = Mat6d::Random();
+  const Mat6d H_sensor = A * A.transpose() + Mat6d::Identity();
+  const double scale = 0.05;
+  const Mat6d H_body = registration::body_information(H_sensor, T_body_sensor, scale);
+  const Vec6d xi_sensor = Vec6d::Random() * 0.01;
+  const Vec6d xi_body = adjoint(T_body_sensor) * xi_sensor;
+  EXPECT_NEAR(xi_body.dot(H_body * xi_body), xi_sensor.dot(H_sensor * xi_sensor) / scale,
+              1e-9 * xi_sensor.dot(H_sensor * xi_sensor) / scale);
+}
+
+TEST(Degeneracy, APlaneLeavesItsInPlaneDirectionsAndNormalRotationFree) {
+  // Information of points on the plane z = 0 around the origin: constrains z, roll and pitch only.
+  Mat6d H = Mat6d::Zero();
+  const Eigen::Vector3d n = Eigen::Vector3d::UnitZ();
+  for (double x = -5.0; x <= 5.0; x += 1.0) {
+    for (double y = -5.0; y <= 5.0; y += 1.0) {
+      Eigen::Matrix<double, 1, 6> J;  // d(n . (R p + t)) / d[t; r] at identity, right perturbation
+      J << n.transpose(), -(n.transpose() * hat(Eigen::Vector3d(x, y, 0.0)));
+      H += J.transpose() * J;
+    }
+  }
+  RegistrationConfig config;
+  const Mat6d C = registration::covariance_from_information(registration::body_information(H, SE3(), 1e-3));
+  EXPECT_TRUE(C.allFinite());
+  const registration::Degeneracy d = registration::analyze_degeneracy(C, config);
+  EXPECT_EQ(d.degenerate_translations, 2);  // x and y
+  EXPECT_EQ(d.degenerate_rotations, 1);     // yaw
+  EXPECT_NEAR(std::abs(d.translation_axes.col(2).z()), 1.0, 1e-9);  // the best-constrained: the normal
+  EXPECT_NEAR(std::abs(d.rotation_axes.col(0).z()), 1.0, 1e-9);     // the free rotation: about the normal
+  EXPECT_NEAR(d.translation_std_m(0), registration::kUnconstrainedStd, 1e-6);
+  EXPECT_LT(d.translation_std_m(2), config.degenerate_translation_std_m);
+}
+
+TEST(Degeneracy, PoseMeasurementCovarianceIsTheBodyCovarianceInStateCoordinates) {
+  // Brute force: the Jacobian of z = [p; angles] of T exp([t; r]) against the one the
+  // covariance is propagated with.
+  std::mt19937 rng(11);
+  FusionConfig config;
+  for (int c = 0; c < 10; ++c) {
+    SE3 pose = random_pose(rng);
+    Mat6d J = Mat6d::Zero();
+    for (int i = 0; i < 6; ++i) {
+      Vec6d d = Vec6d::Zero();
+      d(i) = kStep;
+      const SE3 plus = pose * SE3::exp(d), minus = pose * SE3::exp(-d);
+      J.block<3, 1>(0, i) = (plus.translation() - minus.translation()) / (2 * kStep);
+      const Eigen::Vector3d a_plus = fusion::euler_from_rotation(plus.rotation());
+      const Eigen::Vector3d a_minus = fusion::euler_from_rotation(minus.rotation());
+      for (int k = 0; k < 3; ++k) J(3 + k, i) = fusion::wrap_angle(a_plus(k) - a_minus(k)) / (2 * kStep);
+    }
+    Mat6d A = Mat6d::Random();
+    const Mat6d C = A * A.transpose() * 1e-4;
+    Mat6d expected = J * C * J.transpose();
+    expected.diagonal().head<3>().array() += config.lidar_min_position_std_m * config.lidar_min_position_std_m;
+    expected.diagonal().tail<3>().array() += config.lidar_min_attitude_std_rad * config.lidar_min_attitude_std_rad;
+    const Mat6d R = fusion::pose_measurement_covariance(C, pose, config);
+    EXPECT_LT((R - expected).cwiseAbs().maxCoeff(), 1e-6 * expected.cwiseAbs().maxCoeff()) << c;
+  }
+}
+
+TEST(Degeneracy, VelocityCovarianceGrowsWithThePoseCovariancesOverDt) {
+  FusionConfig config;
+  Mat6d C = Mat6d::Zero();
+  C(0, 0) = 0.04;  // 0.2 m along x in both poses
+  const Eigen::Matrix3d V = fusion::velocity_measurement_covariance(C, C, 0.1, config);
+  const double floor = config.lidar_velocity_std_m_s * config.lidar_velocity_std_m_s;
+  EXPECT_NEAR(V(0, 0), 2 * 0.04 / 0.01 + floor, 1e-12);
+  EXPECT_NEAR(V(1, 1), floor, 1e-12);
+}
+
+}  // namespace
+}  // namespace farlio
