@@ -66,8 +66,8 @@ TEST(Degeneracy, APlaneLeavesItsInPlaneDirectionsAndNormalRotationFree) {
   const Mat6d C = registration::covariance_from_information(registration::body_information(H, SE3(), 1e-3));
   EXPECT_TRUE(C.allFinite());
   const registration::Degeneracy d = registration::analyze_degeneracy(C, config);
-  EXPECT_EQ(d.degenerate_translations, 2);  // x and y
-  EXPECT_EQ(d.degenerate_rotations, 1);     // yaw
+  EXPECT_EQ(d.degenerate_translations, 2);                          // x and y
+  EXPECT_EQ(d.degenerate_rotations, 1);                             // yaw
   EXPECT_NEAR(std::abs(d.translation_axes.col(2).z()), 1.0, 1e-9);  // the best-constrained: the normal
   EXPECT_NEAR(std::abs(d.rotation_axes.col(0).z()), 1.0, 1e-9);     // the free rotation: about the normal
   EXPECT_NEAR(d.translation_std_m(0), registration::kUnconstrainedStd, 1e-6);
