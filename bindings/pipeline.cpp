@@ -184,6 +184,10 @@ void bind_pipeline(nb::module_& m) {
       .def_ro("velocity_body_m_s", &pipeline::FrameResult::velocity_body_m_s)
       .def_ro("angular_velocity_body_rad_s", &pipeline::FrameResult::angular_velocity_body_rad_s)
       .def_ro("registered", &pipeline::FrameResult::registered)
+      .def_ro("failure", &pipeline::FrameResult::failure,
+              "why the registration's pose was not used (empty: it was); the scan kept the prediction")
+      .def_ro("map_restarted", &pipeline::FrameResult::map_restarted,
+              "the map restarted from this scan after registration failures (recovery)")
       .def_prop_ro("converged", [](const pipeline::FrameResult& r) { return r.registration.converged; })
       .def_prop_ro("iterations", [](const pipeline::FrameResult& r) { return r.registration.iterations; })
       .def_prop_ro("inliers", [](const pipeline::FrameResult& r) { return r.registration.system.inliers; })
@@ -206,6 +210,8 @@ void bind_pipeline(nb::module_& m) {
       .def_ro("iterations", &registration::RegistrationResult::iterations)
       .def_ro("converged", &registration::RegistrationResult::converged)
       .def_ro("budget_exceeded", &registration::RegistrationResult::budget_exceeded)
+      .def_ro("held_directions", &registration::RegistrationResult::held_directions,
+              "degenerate directions held at the initial guess in the last Gauss-Newton step")
       .def_ro("time_s", &registration::RegistrationResult::time_s)
       .def_prop_ro("hessian", [](const registration::RegistrationResult& r) { return r.system.H; })
       .def_prop_ro("gradient", [](const registration::RegistrationResult& r) { return r.system.b; })
@@ -266,14 +272,16 @@ void bind_pipeline(nb::module_& m) {
       .def_ro("reinitializations", &fusion::FusionStats::reinitializations)
       .def_ro("imu_gaps", &fusion::FusionStats::imu_gaps)
       .def_ro("imu_samples_dropped", &fusion::FusionStats::imu_samples_dropped)
+      .def_ro("imu_samples_rejected", &fusion::FusionStats::imu_samples_rejected,
+              "IMU samples rejected by the gate (non-finite, impossible, spikes)")
       .def_ro("accel_in_g", &fusion::FusionStats::accel_in_g)
       .def_ro("accel_unit_message", &fusion::FusionStats::accel_unit_message)
       .def_ro("gyro_bias_rad_s", &fusion::FusionStats::gyro_bias_rad_s)
       .def_ro("accel_bias_m_s2", &fusion::FusionStats::accel_bias_m_s2)
       .def_ro("last_warning", &fusion::FusionStats::last_warning)
-      .def("__repr__",
-           attribute_repr({"steps", "lidar_groups_accepted", "lidar_groups_rejected", "reinitializations", "imu_gaps",
-                           "imu_samples_dropped", "accel_in_g", "gyro_bias_rad_s", "last_warning"}));
+      .def("__repr__", attribute_repr({"steps", "lidar_groups_accepted", "lidar_groups_rejected", "reinitializations",
+                                       "imu_gaps", "imu_samples_dropped", "imu_samples_rejected", "accel_in_g",
+                                       "gyro_bias_rad_s", "last_warning"}));
   nb::class_<PyOdometry>(m, "Odometry",
                          "LiDAR-inertial odometry replayed on a simulated clock (LiDAR-only without IMU).")
       .def(nb::init<const Config&, const SE3&, double, std::vector<ImuSample>, const pipeline::ReplayOptions&>(),

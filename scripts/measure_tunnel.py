@@ -14,7 +14,8 @@ and prints, per mode, on the registered scan poses (scans_body.tum):
               truth both taken relative to their first pose (m; + = ahead of the truth)
   slide       the part of it that grew inside the featureless section (m)
 
-Usage: python scripts/measure_tunnel.py --seeds 1 2 [--duration 45] [--work DIR]
+Usage: python scripts/measure_tunnel.py --seeds 1 2 [--duration 45] [--work DIR] [--set KEY=VALUE ...]
+       [--modes lio lidar-only]   (a sequence already in --work is reused)
 """
 
 from __future__ import annotations
@@ -76,6 +77,10 @@ def main() -> None:
     parser.add_argument("--seeds", type=int, nargs="+", default=[1, 2])
     parser.add_argument("--duration", type=float, default=None, help="seconds (default: the profile's, 45 s)")
     parser.add_argument("--work", type=Path, default=None, help="folder for sequences and runs (default: a temp dir)")
+    parser.add_argument(
+        "--set", action="append", default=[], metavar="KEY=VALUE", help="config override for both modes"
+    )
+    parser.add_argument("--modes", nargs="+", choices=list(MODES), default=list(MODES), help="modes to run")
     args = parser.parse_args()
     work = args.work or Path(tempfile.mkdtemp(prefix="tunnel_"))
     rows = []
@@ -84,10 +89,11 @@ def main() -> None:
         sim = ["simulate", "tunnel", "--out", str(seq), "--seed", str(seed), "--no-progress"]
         if args.duration is not None:
             sim += ["--duration", str(args.duration)]
-        if farlio(sim) != 0:
+        if not (seq / "meta.yaml").exists() and farlio(sim) != 0:
             raise SystemExit(f"farlio simulate failed for seed {seed}")
         meta = yaml.safe_load((seq / "meta.yaml").read_text())
-        for mode, extra in MODES.items():
+        for mode in args.modes:
+            extra = MODES[mode] + [a for kv in args.set for a in ("--set", kv)]
             out = work / f"run_s{seed}_{mode}"
             cmd = ["run", str(seq), "--out", str(out), "--latency", "fixed", "--fixed-latency", FIXED_LATENCY_S]
             if farlio(cmd + extra + ["--no-progress", "--no-plot"]) != 0:

@@ -113,6 +113,8 @@ class FrameCounts:
     skipped: int = 0
     dropped: int = 0
     degenerate: int = 0  # registered frames with a degenerate direction
+    failed: int = 0  # registrations whose pose was not used (too few inliers, non-finite)
+    map_restarts: int = 0  # the map restarted after failures (recovery)
 
 
 class OdometryRun:
@@ -215,7 +217,9 @@ class OdometryRun:
         self.lidar_poses.push_back(r.stamp_ns, r.pose)
         self.counts.totals_ms.append(r.timings.total_s * MS_PER_S)
         self.counts.registered += int(r.registered)
-        self.counts.converged += int(r.registered and r.converged)
+        self.counts.converged += int(r.registered and r.converged and not r.failure)
+        self.counts.failed += int(bool(r.failure))
+        self.counts.map_restarts += int(r.map_restarted)
         self.counts.dropped += int(bool(fr.drop_reason))
         self.counts.degenerate += int(fr.degeneracy is not None and fr.degeneracy.degenerate)
 
@@ -246,6 +250,8 @@ class OdometryRun:
             "dropped": c.dropped,
             "registered": c.registered,
             "degenerate": c.degenerate,
+            "registration_failed": c.failed,
+            "map_restarts": c.map_restarts,
             "converged_fraction": c.converged / c.registered if c.registered else float("nan"),
             "latency_ms": {
                 "median": _percentile(totals, MEDIAN_PERCENTILE),
@@ -310,12 +316,18 @@ def _fusion_summary(stats: Any) -> dict[str, Any]:
         _warn(
             f"{stats.imu_gaps} IMU gap(s): no sample for longer than fusion.imu_gap_limit_s (the last input was held)"
         )
+    if stats.imu_samples_rejected:
+        _warn(
+            f"{stats.imu_samples_rejected} IMU sample(s) rejected as non-finite, impossible or spikes "
+            f"(fusion.imu_max_*, fusion.imu_spike_*); the last: {stats.last_warning}"
+        )
     return {
         "lidar_groups_accepted": stats.lidar_groups_accepted,
         "lidar_groups_rejected": stats.lidar_groups_rejected,
         "reinitializations": stats.reinitializations,
         "imu_gaps": stats.imu_gaps,
         "imu_samples_dropped": stats.imu_samples_dropped,
+        "imu_samples_rejected": stats.imu_samples_rejected,
         "accel_in_g": stats.accel_in_g,
         "gyro_bias_rad_s": list(stats.gyro_bias_rad_s),
         "accel_bias_m_s2": list(stats.accel_bias_m_s2),
@@ -339,6 +351,11 @@ def format_summary(s: dict[str, Any]) -> str:
         f"{s['dropped']}), converged {converged}, {s['rate_hz']:.1f} Hz overall",
         f"latency per frame: median {lat['median']:.2f} ms, p99 {lat['p99']:.2f} ms, max {lat['max']:.2f} ms",
     ]
+    if s.get("registration_failed"):
+        lines.append(
+            f"registration failed on {s['registration_failed']} scans (kept the prediction; timing.csv drop_reason), "
+            f"map restarts {s.get('map_restarts', 0)}"
+        )
     for key, label in (("accuracy", "scan poses"), ("accuracy_odometry", "100 Hz odometry")):
         if s.get(key):
             lines.append(f"{label}: {_accuracy_line(s[key])}")

@@ -3,6 +3,8 @@
 // against brute force: perturbations applied to the poses themselves.
 #include <gtest/gtest.h>
 
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <random>
 
 #include "farlio/core/config.hpp"
@@ -72,6 +74,66 @@ TEST(Degeneracy, APlaneLeavesItsInPlaneDirectionsAndNormalRotationFree) {
   EXPECT_NEAR(std::abs(d.rotation_axes.col(0).z()), 1.0, 1e-9);     // the free rotation: about the normal
   EXPECT_NEAR(d.translation_std_m(0), registration::kUnconstrainedStd, 1e-6);
   EXPECT_LT(d.translation_std_m(2), config.degenerate_translation_std_m);
+}
+
+/// The information of a corridor along x (two walls y = +-w, floor z = 0, ceiling z = h):
+/// constrains everything but the translation along x, plus a weak along-track term `weak`.
+Mat6d corridor_information(double weak) {
+  Mat6d H = Mat6d::Zero();
+  const auto add = [&H](const Eigen::Vector3d& n, const Eigen::Vector3d& p) {
+    Eigen::Matrix<double, 1, 6> J;
+    J << n.transpose(), -(n.transpose() * hat(p));
+    H += J.transpose() * J;
+  };
+  for (double x = -20.0; x <= 20.0; x += 1.0) {
+    for (double s = -2.0; s <= 2.0; s += 1.0) {
+      add(Eigen::Vector3d::UnitY(), {x, 5.0, 2.0 + s});
+      add(-Eigen::Vector3d::UnitY(), {x, -5.0, 2.0 + s});
+      add(Eigen::Vector3d::UnitZ(), {x, 2.0 * s, 0.0});
+      add(-Eigen::Vector3d::UnitZ(), {x, 2.0 * s, 5.0});
+    }
+  }
+  H(0, 0) += weak;
+  return H;
+}
+
+TEST(Degeneracy, TheStepHoldsADegenerateDirectionAndSolvesTheOthers) {
+  RegistrationConfig config;
+  const double scale = 0.05;
+  for (const double weak : {0.0, 1e-3, 1e-1}) {  // none, and a weak fake along-track constraint
+    const Mat6d H = corridor_information(weak);
+    const registration::Degeneracy d =
+        registration::analyze_degeneracy(registration::covariance_from_information(H / scale), config);
+    ASSERT_EQ(d.degenerate_translations, 1) << weak;
+    ASSERT_EQ(d.degenerate_rotations, 0) << weak;
+    EXPECT_NEAR(std::abs(d.translation_axes.col(0).x()), 1.0, 1e-9);
+    // b of a pose error [0.5 along track, 0.1 across, -0.05 up; small rotation] seen through H
+    Vec6d error;
+    error << 0.5, 0.1, -0.05, 0.01, -0.02, 0.005;
+    const Vec6d b = H * error;  // the gradient at the wrong pose; the full step would be -error
+    const Vec6d dx = registration::step_without_degenerate_directions(H, b, d);
+    EXPECT_NEAR(dx(0), 0.0, 1e-12) << weak;  // held along the track
+    // the other five directions are solved exactly (the corridor decouples x from them)
+    EXPECT_LT((dx.tail<5>() + error.tail<5>()).norm(), 1e-9) << weak;
+  }
+}
+
+TEST(Degeneracy, WithoutDegenerateDirectionsTheStepIsThePlainSolve) {
+  Mat6d A = Mat6d::Random();
+  const Mat6d H = A * A.transpose() + 100.0 * Mat6d::Identity();
+  const Vec6d b = Vec6d::Random();
+  const registration::Degeneracy none;
+  EXPECT_LT((registration::step_without_degenerate_directions(H, b, none) - H.ldlt().solve(-b)).norm(), 1e-12);
+}
+
+TEST(Degeneracy, ReleasedDirectionsBecomeUnconstrainedAndTheRestIsKept) {
+  RegistrationConfig config;
+  const Mat6d C = registration::covariance_from_information(corridor_information(1e-3) / 0.05);
+  const registration::Degeneracy d = registration::analyze_degeneracy(C, config);
+  const Mat6d released = registration::release_degenerate_directions(C, d);
+  EXPECT_GT(released(0, 0), 0.99 * registration::kUnconstrainedStd * registration::kUnconstrainedStd);
+  EXPECT_LT((released.bottomRightCorner<5, 5>() - C.bottomRightCorner<5, 5>()).norm(), 1e-9);
+  EXPECT_GT(Eigen::SelfAdjointEigenSolver<Mat6d>(released).eigenvalues().minCoeff(), 0.0);  // still a covariance
 }
 
 TEST(Degeneracy, PoseMeasurementCovarianceIsTheBodyCovarianceInStateCoordinates) {

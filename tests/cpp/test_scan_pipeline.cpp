@@ -72,3 +72,83 @@ TEST(ScanPipeline, EmptyAndDegenerateScansDoNotCrash) {
   EXPECT_EQ(r1.kept_points, 0u);
   EXPECT_TRUE(r1.pose.translation().allFinite());
 }
+
+namespace {
+
+/// A scan at frame k's stamps whose points are `points` (sensor frame).
+Scan scan_with_points(int k, double period_s, std::vector<Eigen::Vector3f> points) {
+  Scan s = make_scan(k, period_s);
+  s.points = std::move(points);
+  return s;
+}
+
+double translation_error_m(const SE3& a, const SE3& b) { return (a.inverse() * b).translation().norm(); }
+
+}  // namespace
+
+// Issue 13 item 6 / issue 11 item 4: a scan of 3 points or of one point repeated "converged" with
+// a single inlier and moved the pose by metres; now it fails, keeps the prediction and changes
+// neither the map nor the adaptive threshold, and the next good scan registers as before.
+TEST(ScanPipeline, ADegenerateScanFailsKeepsThePredictionAndChangesNothing) {
+  const double period = 0.1;
+  Config cfg;
+  cfg.num_threads = 2;
+  cfg.registration.time_budget_factor = 1e6;
+  const std::vector<std::vector<Eigen::Vector3f>> bad_scans = {
+      {{3.0f, 1.0f, 0.5f}, {-2.0f, 4.0f, 1.0f}, {5.0f, -3.0f, 0.2f}},         // 3 points
+      std::vector<Eigen::Vector3f>(5000, Eigen::Vector3f(4.0f, 2.0f, 1.0f)),  // one point repeated
+  };
+  for (const auto& bad : bad_scans) {
+    pipeline::ScanPipeline p(cfg, truth_at(period));
+    for (int k = 0; k < 5; ++k) p.process(make_scan(k, period));
+    const std::size_t map_points = p.backend().map_points();
+    const SE3 predicted = p.predict(make_scan(5, period).end_stamp_ns);
+    const auto r = p.process(scan_with_points(5, period, bad));
+    EXPECT_TRUE(r.registered);
+    EXPECT_FALSE(r.failure.empty()) << bad.size() << " points";
+    EXPECT_NE(r.failure.find("too few inliers"), std::string::npos) << r.failure;
+    EXPECT_LT(translation_error_m(r.pose, predicted), 1e-9);  // the prediction, untouched
+    EXPECT_EQ(p.backend().map_points(), map_points);          // the map is unchanged
+    EXPECT_FALSE(r.map_restarted);
+    // the next good scan tracks as before: the threshold and the motion model are intact
+    const auto next = p.process(make_scan(6, period));
+    EXPECT_TRUE(next.failure.empty()) << next.failure;
+    EXPECT_LT(translation_error_m(next.pose, truth_at(7 * period)), 0.03);
+    EXPECT_EQ(next.sigma_m, r.sigma_m);  // the failed scan did not update the threshold
+  }
+}
+
+// Recovery: when registrations fail for map_restart_after_s (the old map no longer matches), the
+// map restarts from the current scan at the prediction, and tracking resumes from there.
+TEST(ScanPipeline, PersistentFailuresRestartTheMapAndTrackingResumes) {
+  const double period = 0.1;
+  Config cfg;
+  cfg.num_threads = 2;
+  cfg.registration.time_budget_factor = 1e6;
+  cfg.registration.map_restart_after_s = 0.25;
+  pipeline::ScanPipeline p(cfg, truth_at(period));
+  for (int k = 0; k < 4; ++k) p.process(make_scan(k, period));
+  // a patch of a plane 40 m above the scene: no map point within the correspondence distance
+  constexpr int kSide = 40;
+  constexpr float kStep_m = 0.5f;
+  std::vector<Eigen::Vector3f> far;
+  for (int i = 0; i < kSide * kSide; ++i) {
+    far.emplace_back(30.0f + kStep_m * static_cast<float>(i % kSide), kStep_m * static_cast<float>(i / kSide - 20),
+                     40.0f);
+  }
+  bool restarted = false;
+  int k = 4;
+  for (; k < 10 && !restarted; ++k) {
+    const auto r = p.process(scan_with_points(k, period, far));
+    EXPECT_FALSE(r.failure.empty());
+    EXPECT_TRUE(r.pose.translation().allFinite());
+    restarted = r.map_restarted;
+  }
+  EXPECT_TRUE(restarted);
+  EXPECT_EQ(k - 1, 7);  // failures from k = 4 (0.5 s) on: k = 7 is the first 0.25 s or more after it
+  EXPECT_GT(p.backend().map_points(), 0u);
+  // the restarted map holds the new scene: the next scan of it registers
+  const auto next = p.process(scan_with_points(k, period, far));
+  EXPECT_TRUE(next.failure.empty()) << next.failure;
+  EXPECT_FALSE(next.map_restarted);
+}

@@ -92,10 +92,21 @@ inline constexpr double kMaxVoxelCapacity = 2147483647.0;
   FIELD(double, covariance_scale, 0.05, range::positive(),                                                          \
         "pose covariance = covariance_scale * H^-1 (H in the factors' normalised units; docs/fusion.md measures "   \
         "1e-3..2e-3 on consecutive scans and inflates it for errors shared through the map)")                       \
-  FIELD(double, degenerate_translation_std_m, 0.1, range::positive(),                                               \
+  FIELD(double, degenerate_translation_std_m, 0.05, range::positive(),                                              \
         "a body-frame direction whose translation std (from covariance_scale * H^-1) exceeds this is degenerate")   \
   FIELD(double, degenerate_rotation_std_rad, 0.01, range::positive(),                                               \
-        "a body-frame axis whose rotation std exceeds this is degenerate")
+        "a body-frame axis whose rotation std exceeds this is degenerate")                                          \
+  FIELD(bool, hold_degenerate_directions, true, range::unchecked(),                                                 \
+        "Gauss-Newton does not move the pose along degenerate directions (they stay at the prediction) and the "    \
+        "fusion takes them from the IMU; false: the scan's weak constraint is used as it is")                       \
+  FIELD(int, min_inliers, 100, range::at_least(1),                                                                  \
+        "a registration with fewer correspondences has failed: the scan keeps the predicted pose and updates "      \
+        "neither the map, the adaptive threshold nor the fusion")                                                   \
+  FIELD(double, min_inlier_fraction, 0.5, range::fraction(),                                                        \
+        "a registration matching fewer of the source points has failed (a scan of something else: a bogus "         \
+        "scan, a sensor fault)")                                                                                    \
+  FIELD(double, map_restart_after_s, 1.0, range::positive_or_inf(),                                                 \
+        "after failed registrations for this long, the map restarts from the current scan at the prediction")
 
 // ---- fusion: the kinematic EKF (paper eqs. 7-10) fusing IMU inputs with LiDAR poses -------------
 // Variances are given as standard deviations (unit in the name); docs/fusion.md explains each.
@@ -135,6 +146,16 @@ inline constexpr double kMaxVoxelCapacity = 2147483647.0;
   FIELD(double, accel_bias_std_m_s2, 0.1, range::positive(), "initial std of the accelerometer bias state")           \
   FIELD(double, gyro_bias_walk_rad_s2_sqrt_hz, 2e-4, range::non_negative(), "gyro bias random walk density")          \
   FIELD(double, accel_bias_walk_m_s3_sqrt_hz, 2e-3, range::non_negative(), "accelerometer bias random walk density")  \
+  FIELD(double, imu_max_accel_m_s2, 160.0, range::positive(),                                                         \
+        "an IMU sample with |accel| over this is impossible and rejected (16 g: MEMS full scale)")                    \
+  FIELD(double, imu_max_gyro_rad_s, 35.0, range::positive(),                                                          \
+        "an IMU sample with |gyro| over this is impossible and rejected (2000 deg/s: MEMS full scale)")               \
+  FIELD(double, imu_spike_accel_m_s2, 50.0, range::positive(),                                                        \
+        "an accelerometer axis this far from the median of the recent samples is a spike: rejected")                  \
+  FIELD(double, imu_spike_gyro_rad_s, 10.0, range::positive(),                                                        \
+        "a gyro axis this far from the median of the recent samples is a spike: rejected")                            \
+  FIELD(int, imu_spike_window_samples, 9, range::non_negative(),                                                      \
+        "samples in the spike median (0: no spike test); a real step passes after half of them")                      \
   FIELD(bool, outlier_rejection, true, range::unchecked(), "Mahalanobis outlier rejection per measurement group")     \
   FIELD(double, outlier_chi2_3dof, 16.27, range::positive(), "chi-square gate of 3-dof groups (99.9 % quantile)")     \
   FIELD(double, outlier_chi2_2dof, 13.82, range::positive(), "chi-square gate of 2-dof groups (99.9 % quantile)")     \

@@ -50,6 +50,7 @@ SensorFusion::SensorFusion(const FusionConfig& config, double gravity_m_s2)
       step_ns_(seconds_to_ns(config.step_s)),
       ekf_(gravity_m_s2, input_variance(config), bias_walk_variance(config)),
       imu_(config.imu_gap_limit_s, config.history_s),
+      imu_gate_(config),
       accel_unit_(config.accel_unit_detection, config.accel_unit_detection_samples, gravity_m_s2),
       bias_(config, gravity_m_s2),
       reference_(config.reference_filter_taps, gravity_m_s2, config.reference_max_sin),
@@ -72,6 +73,11 @@ double SensorFusion::gate(int dim) const {
 }
 
 void SensorFusion::add_imu(const ImuSample& sample) {
+  if (const std::string why = imu_gate_.check(sample, accel_unit_.scale()); !why.empty()) {
+    ++stats_.imu_samples_rejected;
+    warn("IMU sample at " + std::to_string(sample.stamp_ns) + " ns rejected: " + why);
+    return;
+  }
   if (!imu_.push(sample)) {
     ++stats_.imu_samples_dropped;
     warn("IMU sample at " + std::to_string(sample.stamp_ns) + " ns is older than the newest one: dropped");

@@ -13,6 +13,7 @@
 #include "farlio/fusion/accel_unit_detector.hpp"
 #include "farlio/fusion/delay_compensation.hpp"
 #include "farlio/fusion/imu_buffer.hpp"
+#include "farlio/fusion/imu_gate.hpp"
 #include "farlio/fusion/kinematic_ekf.hpp"
 #include "farlio/fusion/reference_angles.hpp"
 #include "farlio/fusion/standstill_bias.hpp"
@@ -37,6 +38,7 @@ struct FusionStats {
   std::int64_t reference_angles_rejected = 0;                 ///< gated or saturated
   std::int64_t imu_gaps = 0;                                  ///< gap events (each held-input stretch counts once)
   std::int64_t imu_samples_dropped = 0;                       ///< older than the newest sample
+  std::int64_t imu_samples_rejected = 0;                      ///< by the gate (imu_gate.hpp)
   bool accel_in_g = false;                                    ///< the accelerometer was detected to report in g
   std::string accel_unit_message;                             ///< printable note when accel_in_g
   Eigen::Vector3d gyro_bias_rad_s = Eigen::Vector3d::Zero();  ///< standstill estimate + filter state
@@ -105,6 +107,7 @@ class SensorFusion {
   std::int64_t step_ns_;
   KinematicEkf ekf_;
   ImuBuffer imu_;
+  ImuGate imu_gate_;
   AccelUnitDetector accel_unit_;
   StandstillGyroBias bias_;
   ReferenceAngleEstimator reference_;

@@ -51,6 +51,9 @@ SE3 gravity_aligned_start(const std::vector<ImuSample>& imu, std::int64_t until_
 }
 
 std::string drop_reason(const FrameResult& result, bool map_started) {
+  if (!result.failure.empty()) {
+    return result.map_restarted ? result.failure + "; the map restarted from this scan" : result.failure;
+  }
   if (!result.registered && map_started) return "nothing to register against";
   if (result.registration.budget_exceeded) return "registration exceeded its time budget";
   return {};
@@ -107,6 +110,10 @@ void FusionDriver::link(const Scan& scan, OdometryFrame& frame) {
     covariance = registration::covariance_from_information(registration::body_information(
         frame.scan.registration.system.H, T_imu_lidar_, registration_config_.covariance_scale));
     frame.degeneracy = registration::analyze_degeneracy(*covariance, registration_config_);
+    // the registration held these at the prior: the scan says nothing there
+    if (registration_config_.hold_degenerate_directions) {
+      covariance = registration::release_degenerate_directions(*covariance, *frame.degeneracy);
+    }
   }
   if (frame.drop_reason.empty() && fusion_) {
     const std::int64_t stamp_ns = scan.end_stamp_ns;

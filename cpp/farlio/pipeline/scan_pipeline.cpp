@@ -106,15 +106,33 @@ FrameResult ScanPipeline::process(const Scan& scan, const std::optional<SE3>& in
         backend_->register_source(out.initial_guess, registration::Thresholds::from_sigma(out.sigma_m, p2p),
                                   config_.registration, config_.registration.time_budget_factor * period_s);
     out.registered = true;
-    pose = out.registration.pose;
-    threshold_.update(out.initial_guess.inverse() * pose);
+    out.failure = registration::failure_reason(out.registration, source.points, config_.registration);
+    if (out.failure.empty()) {
+      pose = out.registration.pose;
+      threshold_.update(out.initial_guess.inverse() * pose);
+    }
+  } else if (backend_->map_voxels() > 0) {
+    out.failure = "nothing to register against (no points after preprocessing)";
   }
   out.pose = pose;
   out.timings.registration_s = seconds_since(t0);
 
-  // 4. submap update with the adaptive density, then removal of far voxels
+  // 4. submap update with the adaptive density, then removal of far voxels. A failed scan
+  // changes nothing, unless failures have lasted map_restart_after_s: then the map restarts
+  // from this scan at the prediction (recovery when the old map no longer matches).
   t0 = Clock::now();
-  out.map_insert = backend_->update_map(pose, limit, &out.removed_voxels);
+  if (out.failure.empty()) {
+    failing_since_ns_.reset();
+  } else {
+    if (!failing_since_ns_) failing_since_ns_ = scan.end_stamp_ns;
+    const double failing_s = ns_to_seconds(scan.end_stamp_ns - *failing_since_ns_);
+    if (out.kept_points > 0 && failing_s >= config_.registration.map_restart_after_s) {
+      backend_->reset(config_);
+      out.map_restarted = true;
+      failing_since_ns_.reset();
+    }
+  }
+  if (out.failure.empty() || out.map_restarted) out.map_insert = backend_->update_map(pose, limit, &out.removed_voxels);
   out.map_voxels = backend_->map_voxels();
   out.map_points = backend_->map_points();
   out.timings.map_update_s = seconds_since(t0);

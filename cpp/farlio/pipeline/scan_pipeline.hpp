@@ -34,8 +34,12 @@ struct FrameResult {
   Eigen::Vector3d angular_velocity_body_rad_s = Eigen::Vector3d::Zero();
   registration::RegistrationResult registration;
   bool registered = false;  ///< false for the first scan (it starts the map)
-  double sigma_m = 0;       ///< adaptive threshold used
-  int density_limit = 0;    ///< close-range per-voxel limit chosen by ASMD
+  /// Why the registration's pose was not used (empty when it was): too few inliers, a
+  /// non-finite pose. The scan then keeps the predicted pose and changes no state.
+  std::string failure;
+  bool map_restarted = false;  ///< the map was restarted from this scan (after failures, recovery)
+  double sigma_m = 0;          ///< adaptive threshold used
+  int density_limit = 0;       ///< close-range per-voxel limit chosen by ASMD
   std::size_t input_points = 0, kept_points = 0, source_points = 0;
   map::InsertStats map_insert;
   std::size_t map_voxels = 0, map_points = 0, removed_voxels = 0;
@@ -85,6 +89,7 @@ class ScanPipeline {
   std::int64_t last_stamp_ns_ = 0, prev_stamp_ns_ = 0;
   std::size_t frames_ = 0;
   bool scale_fixed_ = false;
+  std::optional<std::int64_t> failing_since_ns_;  ///< scan end of the first failure in a row
 };
 
 }  // namespace farlio::pipeline

@@ -1,6 +1,8 @@
 #include "farlio/registration/degeneracy.hpp"
 
+#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
 
@@ -54,6 +56,34 @@ Degeneracy analyze_degeneracy(const Mat6d& covariance, const RegistrationConfig&
   d.degenerate_translations = count_over(t.std, config.degenerate_translation_std_m);
   d.degenerate_rotations = count_over(r.std, config.degenerate_rotation_std_rad);
   return d;
+}
+
+Eigen::Matrix<double, 6, Eigen::Dynamic> degenerate_directions(const Degeneracy& d) {
+  Eigen::Matrix<double, 6, Eigen::Dynamic> C =
+      Eigen::Matrix<double, 6, Eigen::Dynamic>::Zero(6, d.degenerate_translations + d.degenerate_rotations);
+  // the stds are sorted largest first: the degenerate axes are the first columns of each block
+  for (int i = 0; i < d.degenerate_translations; ++i) C.col(i).head<3>() = d.translation_axes.col(i);
+  for (int i = 0; i < d.degenerate_rotations; ++i)
+    C.col(d.degenerate_translations + i).tail<3>() = d.rotation_axes.col(i);
+  return C;
+}
+
+Vec6d step_without_degenerate_directions(const Mat6d& H, const Vec6d& b, const Degeneracy& d) {
+  if (!d.degenerate()) return H.ldlt().solve(-b);
+  const Eigen::Matrix<double, 6, Eigen::Dynamic> C = degenerate_directions(d);
+  const auto m = C.cols();
+  if (m >= 6) return Vec6d::Zero();
+  // N: an orthonormal basis of the steps orthogonal to every degenerate direction
+  const Mat6d Q = Eigen::HouseholderQR<Eigen::Matrix<double, 6, Eigen::Dynamic>>(C).householderQ();
+  const Eigen::Matrix<double, 6, Eigen::Dynamic> N = Q.rightCols(6 - m);
+  const Eigen::MatrixXd H_reduced = N.transpose() * H * N;
+  const Eigen::VectorXd y = H_reduced.ldlt().solve(-(N.transpose() * b));
+  return N * y;
+}
+
+Mat6d release_degenerate_directions(const Mat6d& covariance, const Degeneracy& d) {
+  const Eigen::Matrix<double, 6, Eigen::Dynamic> C = degenerate_directions(d);
+  return covariance + kUnconstrainedStd * kUnconstrainedStd * C * C.transpose();
 }
 
 }  // namespace farlio::registration

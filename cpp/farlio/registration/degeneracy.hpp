@@ -9,6 +9,7 @@
 
 #include "farlio/core/config.hpp"
 #include "farlio/core/se3.hpp"
+#include "farlio/registration/linear_system.hpp"
 
 namespace farlio::registration {
 
@@ -34,7 +35,20 @@ struct Degeneracy {
   [[nodiscard]] bool degenerate() const { return degenerate_translations + degenerate_rotations > 0; }
 };
 
-/// The principal stds of the marginal covariance blocks of `covariance` ([t; r], body frame).
+/// The principal stds of the marginal covariance blocks of `covariance` ([t; r], any frame: the
+/// axes are in the covariance's frame).
 Degeneracy analyze_degeneracy(const Mat6d& covariance, const RegistrationConfig& config);
+
+/// The directions of `d` over their thresholds as unit columns of a 6 x m matrix ([t; r]).
+Eigen::Matrix<double, 6, Eigen::Dynamic> degenerate_directions(const Degeneracy& d);
+
+/// The Gauss-Newton step: minimises |H dx + b| over the steps with no component along the
+/// degenerate directions of `d` (solution remapping: the pose stays at its initial guess along
+/// them). Without degenerate directions, the plain solve of H dx = -b.
+Vec6d step_without_degenerate_directions(const Mat6d& H, const Vec6d& b, const Degeneracy& d);
+
+/// `covariance` with the degenerate directions of `d` released: variance kUnconstrainedStd^2 added
+/// along each, so that a filter takes the state there from its own prediction.
+Mat6d release_degenerate_directions(const Mat6d& covariance, const Degeneracy& d);
 
 }  // namespace farlio::registration

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "farlio/registration/degeneracy.hpp"
 #include "farlio/registration/factor_sums.hpp"
 
 namespace farlio::registration {
@@ -56,6 +57,22 @@ RegistrationResult register_scan(const SourceCloud& source, const map::ConstMapV
                       initial_guess, config, time_budget_s);
 }
 
+std::string failure_reason(const RegistrationResult& result, std::size_t source_points,
+                           const RegistrationConfig& config) {
+  if (!result.pose.matrix().allFinite()) return "registration gave a non-finite pose";
+  const long inliers = result.system.inliers;
+  if (inliers < config.min_inliers) {
+    return "too few inliers (" + std::to_string(inliers) + " < registration.min_inliers " +
+           std::to_string(config.min_inliers) + ")";
+  }
+  if (static_cast<double>(inliers) < config.min_inlier_fraction * static_cast<double>(source_points)) {
+    return "too few inliers (" + std::to_string(inliers) + " of " + std::to_string(source_points) +
+           " points, under registration.min_inlier_fraction)";
+  }
+  if (result.budget_exceeded) return "registration exceeded its time budget";
+  return {};
+}
+
 RegistrationResult gauss_newton(const SystemBuilder& build, const SE3& initial_guess, const RegistrationConfig& config,
                                 double time_budget_s) {
   using Clock = std::chrono::steady_clock;
@@ -68,7 +85,12 @@ RegistrationResult gauss_newton(const SystemBuilder& build, const SE3& initial_g
     res.iterations = it + 1;
     if (res.system.inliers == 0) break;  // nothing to register against: not converged
     const Mat6d H = res.system.H + config.damping * Mat6d::Identity();
-    const Vec6d dx = H.ldlt().solve(-res.system.b);
+    Degeneracy degeneracy;  // none unless held
+    if (config.hold_degenerate_directions) {
+      degeneracy = analyze_degeneracy(covariance_from_information(H / config.covariance_scale), config);
+    }
+    res.held_directions = degeneracy.degenerate_translations + degeneracy.degenerate_rotations;
+    const Vec6d dx = step_without_degenerate_directions(H, res.system.b, degeneracy);
     if (!dx.allFinite()) break;
     res.pose = res.pose * SE3::exp(dx);
     if (dx.norm() < config.convergence_norm) {

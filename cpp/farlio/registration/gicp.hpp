@@ -4,6 +4,7 @@
 // kernel scale kappa = sigma / 3 (KISS-ICP's adaptive threshold), stopped when |dx| falls below
 // the convergence norm or the time budget runs out. Returns the pose with the linear system.
 #include <functional>
+#include <string>
 #include <vector>
 
 #include "farlio/core/config.hpp"
@@ -28,6 +29,7 @@ struct RegistrationResult {
   int iterations = 0;
   bool converged = false;        ///< |dx| fell below the convergence norm
   bool budget_exceeded = false;  ///< stopped by the time budget
+  int held_directions = 0;       ///< degenerate directions held at the guess in the last step
   double time_s = 0.0;
 };
 
@@ -62,11 +64,18 @@ RegistrationResult register_scan(const SourceCloud& source, const map::ConstMapV
                                  const Thresholds& th, const RegistrationConfig& config, double time_budget_s,
                                  exec::CpuExecutor& executor);
 
+/// Why a registration's pose must not be used (empty when it may): a non-finite pose, fewer
+/// inliers than config.min_inliers or than config.min_inlier_fraction of the source's points, or
+/// stopped by the time budget before converging.
+std::string failure_reason(const RegistrationResult& result, std::size_t source_points,
+                           const RegistrationConfig& config);
+
 /// Builds the linear system of the source at pose T (a backend's reduction).
 using SystemBuilder = std::function<LinearSystem(const SE3&)>;
 
 /// The Gauss-Newton loop on SE(3), whatever backend builds the systems: stops at convergence,
-/// without inliers, or when the time budget is spent.
+/// without inliers, or when the time budget is spent. With hold_degenerate_directions, each step
+/// leaves the pose unchanged along the directions the system does not constrain (degeneracy.hpp).
 RegistrationResult gauss_newton(const SystemBuilder& build, const SE3& initial_guess, const RegistrationConfig& config,
                                 double time_budget_s);
 
