@@ -21,16 +21,8 @@ namespace farlio::python {
 namespace {
 
 template <typename T>
-using Vector1 = nb::ndarray<nb::numpy, T, nb::ndim<1>>;
-using Points = nb::ndarray<nb::numpy, float, nb::shape<-1, 3>>;
-template <typename T>
 using In1 = nb::ndarray<const T, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
 using InPoints = nb::ndarray<const float, nb::shape<-1, 3>, nb::c_contig, nb::device::cpu>;
-
-template <typename T>
-Vector1<T> view(std::vector<T>& v, nb::handle owner) {
-  return Vector1<T>(v.data(), {v.size()}, owner);
-}
 
 template <typename T>
 void assign(std::vector<T>& dst, const std::optional<In1<T>>& src, std::size_t n, const char* name) {
@@ -97,20 +89,16 @@ void bind_core(nb::module_& m) {
       .def_rw("start_stamp_ns", &Scan::start_stamp_ns)
       .def_rw("end_stamp_ns", &Scan::end_stamp_ns)
       .def_prop_ro(
-          "points",
-          [](nb::handle self) {
-            Scan& s = nb::cast<Scan&>(self);
-            return Points(s.points.data()->data(), {s.size(), 3}, self);
-          },
+          "points", [](nb::handle self) { return points_view(nb::cast<Scan&>(self).points, self); },
           "(N, 3) float32 view of the points (LiDAR frame, raw)")
       .def_prop_ro(
-          "time_s", [](nb::handle self) { return view(nb::cast<Scan&>(self).time_s, self); },
+          "time_s", [](nb::handle self) { return vector_view(nb::cast<Scan&>(self).time_s, self); },
           "(N,) float32 view: per-point time in s since scan start (empty: none)")
       .def_prop_ro(
-          "intensity", [](nb::handle self) { return view(nb::cast<Scan&>(self).intensity, self); },
+          "intensity", [](nb::handle self) { return vector_view(nb::cast<Scan&>(self).intensity, self); },
           "(N,) float32 view of intensities (empty: none)")
       .def_prop_ro(
-          "sensor_id", [](nb::handle self) { return view(nb::cast<Scan&>(self).sensor_id, self); },
+          "sensor_id", [](nb::handle self) { return vector_view(nb::cast<Scan&>(self).sensor_id, self); },
           "(N,) uint8 view of sensor indices (empty: none)")
       .def("__len__", &Scan::size)
       .def_prop_ro("duration_s", &Scan::duration_s)

@@ -10,6 +10,7 @@ NB_MODULE(_core, m) {
   farlio::python::bind_core(m);
   auto io = m.def_submodule("io", "file formats and the sequence folder");
   farlio::python::bind_io(io);
+  farlio::python::bind_pointcloud2(io);
   auto sim = m.def_submodule("sim", "LiDAR + IMU sequence generator");
   farlio::python::bind_sim(sim);
   auto ev = m.def_submodule("eval", "trajectory evaluation: APE, RPE, coverage");

@@ -334,8 +334,13 @@ void bind_pipeline(nb::module_& m) {
           "add_imu", [](PyOnlineOdometry& o, const ImuSample& s) { o.odometry.add_imu(s); }, "sample"_a,
           nb::call_guard<nb::gil_scoped_release>())
       .def(
-          "add_scan", [](PyOnlineOdometry& o, const Scan& s) { return o.odometry.add_scan(s); }, "scan"_a,
-          nb::call_guard<nb::gil_scoped_release>(), "False when dropped because the worker was busy.")
+          "add_scan",
+          [](PyOnlineOdometry& o, Scan& s, bool consume) {
+            return consume ? o.odometry.add_scan(std::move(s)) : o.odometry.add_scan(s);
+          },
+          "scan"_a, nb::kw_only(), "consume"_a = false, nb::call_guard<nb::gil_scoped_release>(),
+          "False when dropped because the worker was busy. consume=True moves the scan's arrays in instead of "
+          "copying them (the scan is left empty).")
       .def(
           "wait_idle", [](PyOnlineOdometry& o) { o.odometry.wait_idle(); }, nb::call_guard<nb::gil_scoped_release>(),
           "Blocks until every scan handed over is processed.")

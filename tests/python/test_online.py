@@ -65,3 +65,29 @@ def test_online_odometry_from_two_python_threads_equals_the_replay(tmp_path):
         max(np.abs(s.body_pose.translation - p.translation).max() for s, (_, p) in zip(samples, expected_odometry))
         < 1e-6
     )
+
+
+def test_add_scan_consume_moves_the_scan_in_with_the_same_result(tmp_path):
+    """consume=True (what the ROS node does) leaves the Python scan empty and gives the frames of a
+    copied scan."""
+    from farlio.datasets import open_dataset
+    from farlio.simulation import generate
+
+    seq = tmp_path / "urban"
+    generate("urban", seq, duration_s=0.6)
+    ds = open_dataset(seq)
+    poses = []
+    for consume in (False, True):
+        online = farlio.OnlineOdometry(farlio.Config(), ds.T_imu_lidar(), ds.gravity_m_s2())
+        for i in range(len(ds)):
+            scan = ds.scan(i)
+            n = len(scan)
+            assert online.add_scan(scan, consume=consume)
+            assert len(scan) == (0 if consume else n)
+            assert len(scan.time_s) == (0 if consume else n)
+            online.wait_idle()
+        online.stop()
+        frames = online.take_frames()
+        assert len(frames) == len(ds) and all(f.processed for f in frames)
+        poses.append(np.array([f.body_pose.matrix() for f in frames]))
+    np.testing.assert_array_equal(poses[0], poses[1])

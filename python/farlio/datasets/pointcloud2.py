@@ -1,8 +1,10 @@
 """sensor_msgs/PointCloud2 to numpy: the byte layout from the message's fields, and the per-point
 time convention of the driver that wrote it.
 
-Decoding is vectorised: one structured numpy dtype built from the fields (offsets, point_step,
-endianness; padding bytes are simply not named), one `np.frombuffer`, no per-point Python.
+Decoding: the rules (which field is the time, its unit, whether the header stamp is the scan start
+or end) are here; the bytes are read by C++ (farlio._core.io.decode_pointcloud2: any PointField
+datatype, either byte order, padding in points and rows) in one pass per field, straight into the
+arrays of the Cloud. The bag loader and the ROS 2 node both decode with `decode`.
 
 Per-point time conventions found in the wild (all handled by `TimeOptions` 'auto'):
 
@@ -28,10 +30,13 @@ from typing import Any
 
 import numpy as np
 
-from farlio._core import NS_PER_S
+from farlio._core import NS_PER_S, InputError
+from farlio._core import io as _io
 
 #: PointField datatype codes (sensor_msgs/PointField) -> numpy type
 POINTFIELD_TYPES = {1: "i1", 2: "u1", 3: "i2", 4: "u2", 5: "i4", 6: "u4", 7: "f4", 8: "f8"}
+#: the floating-point datatypes (their time values are read as s by the 'auto' unit)
+FLOAT_DATATYPES = (7, 8)
 #: names of the per-point time field, first found wins
 TIME_FIELDS = ("t", "time", "timestamp", "offset_time", "time_stamp", "time_offset", "ts")
 INTENSITY_FIELDS = ("intensity", "reflectivity", "i")
@@ -98,54 +103,6 @@ def field_names(msg: Any) -> list[str]:
     return [f.name for f in msg.fields]
 
 
-def cloud_dtype(msg: Any, where: str) -> np.dtype:
-    """The structured dtype of one point: every field at its offset, itemsize point_step."""
-    order = ">" if msg.is_bigendian else "<"
-    names, formats, offsets = [], [], []
-    for f in msg.fields:
-        if f.datatype not in POINTFIELD_TYPES:
-            raise CloudError(
-                f"{where}: field '{f.name}' has datatype {f.datatype}; expected one of "
-                f"{sorted(POINTFIELD_TYPES)} (sensor_msgs/PointField)"
-            )
-        base = np.dtype(order + POINTFIELD_TYPES[f.datatype])
-        count = max(int(f.count), 1)
-        if f.offset + base.itemsize * count > msg.point_step:
-            raise CloudError(
-                f"{where}: field '{f.name}' at offset {f.offset} ({count} x {base.itemsize} bytes) "
-                f"extends past point_step {msg.point_step}"
-            )
-        if f.name in names:  # duplicate names (some drivers): keep the first
-            continue
-        names.append(f.name)
-        formats.append(base if count == 1 else (base, (count,)))
-        offsets.append(f.offset)
-    return np.dtype({"names": names, "formats": formats, "offsets": offsets, "itemsize": msg.point_step})
-
-
-def structured_points(msg: Any, where: str) -> np.ndarray:
-    """The message's points as a 1-D structured array (rows with padding at their ends handled)."""
-    dtype = cloud_dtype(msg, where)
-    n = int(msg.width) * int(msg.height)
-    data = (
-        np.ascontiguousarray(msg.data).view(np.uint8).reshape(-1)
-        if isinstance(msg.data, np.ndarray)
-        else np.frombuffer(msg.data, dtype=np.uint8)
-    )
-    row_bytes = int(msg.width) * int(msg.point_step)
-    row_step = int(msg.row_step) or row_bytes
-    needed = (int(msg.height) - 1) * row_step + row_bytes if n else 0
-    if data.size < needed:
-        raise CloudError(
-            f"{where}: data holds {data.size} bytes but {msg.height} rows of {msg.width} points "
-            f"need {needed} (row_step {row_step}, point_step {msg.point_step}; truncated?)"
-        )
-    if row_step == row_bytes or msg.height <= 1:
-        return np.frombuffer(data[: n * msg.point_step], dtype=dtype)
-    rows = np.lib.stride_tricks.as_strided(data, shape=(msg.height, row_bytes), strides=(row_step, 1))
-    return np.frombuffer(np.ascontiguousarray(rows), dtype=dtype)
-
-
 def _time_field(names: Sequence[str], options: TimeOptions, where: str) -> str | None:
     if options.field == "none":
         return None
@@ -156,74 +113,82 @@ def _time_field(names: Sequence[str], options: TimeOptions, where: str) -> str |
     return next((n for n in TIME_FIELDS if n in names), None)
 
 
-def _offsets_s(values: np.ndarray, header_ns: int, name: str, options: TimeOptions, where: str) -> np.ndarray:
-    """Per-point offsets in s from the header stamp."""
-    if values.dtype.kind not in "iuf":
-        raise CloudError(f"{where}: time field '{name}' has type {values.dtype}; expected a number")
-    unit = options.unit
-    if unit == "auto":
-        unit = "s" if values.dtype.kind == "f" else "ns"
-    scale = NS_PER_UNIT[unit] / NS_PER_S
-    if values.size == 0:
-        return np.zeros(0)
-    lo, hi = float(values.min()), float(values.max())
-    if lo * scale > ABSOLUTE_TIME_MIN_S:
-        # absolute times: subtract the header in float64 seconds (precision ~0.2 us for Unix times)
-        offsets = values.astype(np.float64) * scale - header_ns / NS_PER_S
-        if values.dtype.kind != "f":
-            offsets = (values.astype(np.int64) * NS_PER_UNIT[unit] - header_ns) / NS_PER_S
-    else:
-        offsets = values.astype(np.float64) * scale
-    span = (hi - lo) * scale
+def _data(msg: Any) -> np.ndarray:
+    """The message's data as a 1-D uint8 array, without a copy for a uint8 array (rosbags), an
+    array.array (rclpy) or bytes."""
+    if isinstance(msg.data, np.ndarray):
+        return np.ascontiguousarray(msg.data).view(np.uint8).reshape(-1)
+    try:
+        return np.frombuffer(msg.data, dtype=np.uint8)
+    except TypeError:  # a list of ints
+        return np.asarray(msg.data, dtype=np.uint8)
+
+
+def _check_span(points: Any, name: str, datatype: int, unit: str, where: str) -> None:
+    """A scan lasts at most MAX_SCAN_SPAN_S: a longer span of the time field means a wrong unit."""
+    lo, hi = points.time_min, points.time_max
+    span = (hi - lo) * NS_PER_UNIT[unit] / NS_PER_S
     if not np.isfinite(span) or span > MAX_SCAN_SPAN_S:
         raise CloudError(
-            f"{where}: time field '{name}' ({values.dtype}) spans {hi - lo:g} raw units, which in "
-            f"{unit} is {span:g} s, longer than a scan can last ({MAX_SCAN_SPAN_S:g} s): unknown time "
-            f"unit; pass the unit explicitly (--time-unit one of {', '.join(NS_PER_UNIT)}) or "
+            f"{where}: time field '{name}' ({np.dtype(POINTFIELD_TYPES[datatype]).name}) spans {hi - lo:g} raw "
+            f"units, which in {unit} is {span:g} s, longer than a scan can last ({MAX_SCAN_SPAN_S:g} s): unknown "
+            f"time unit; pass the unit explicitly (--time-unit one of {', '.join(NS_PER_UNIT)}) or "
             f"--time-field none"
         )
-    return offsets
 
 
 def decode(msg: Any, where: str, options: TimeOptions | None = None) -> Cloud:
-    """Decodes a sensor_msgs/PointCloud2 (as deserialised by rosbags or any object with the same
-    attributes). Points at the origin (no return) are dropped. Raises CloudError naming `where`."""
+    """Decodes a sensor_msgs/PointCloud2 (as deserialised by rosbags or rclpy, or any object with the
+    same attributes). Points at the origin (no return) are dropped. Raises CloudError naming `where`.
+
+    The fields, the time unit and the header stamp's meaning are chosen here; the bytes are read in
+    one C++ pass (farlio._core.io.decode_pointcloud2), the arrays are views of its result."""
     options = options or TimeOptions()
     names = field_names(msg)
-    missing = [c for c in "xyz" if c not in names]
-    if missing:
-        raise CloudError(
-            f"{where}: PointCloud2 has no field {', '.join(repr(m) for m in missing)} "
-            f"(fields: {', '.join(names) or 'none'}); expected x, y, z"
-        )
-    pts = structured_points(msg, where)
-    xyz = np.empty((len(pts), 3), dtype=np.float32)
-    for k, c in enumerate("xyz"):
-        if pts.dtype[c].shape:
-            raise CloudError(f"{where}: field '{c}' has count {pts.dtype[c].shape[0]}; expected 1")
-        xyz[:, k] = pts[c]
-    origin = (xyz[:, 0] == 0.0) & (xyz[:, 1] == 0.0) & (xyz[:, 2] == 0.0)  # no return
-    keep = np.flatnonzero(~origin) if origin.any() else slice(None)
-    xyz = xyz[keep]
-    header_ns = stamp_ns(msg.header)
-    inten_name = next((n for n in INTENSITY_FIELDS if n in names and not pts.dtype[n].shape), None)
-    intensity = pts[inten_name][keep].astype(np.float32) if inten_name else None
+    fields = [(str(f.name), int(f.offset), int(f.datatype), int(f.count)) for f in msg.fields]
+    first: dict[str, tuple[int, int]] = {}  # name -> (datatype, count) of its first field
+    for name, _, datatype, count in fields:
+        first.setdefault(name, (datatype, count))
     tname = _time_field(names, options, where)
+    inten_name = next((n for n in INTENSITY_FIELDS if n in first and first[n][1] <= 1), None)
+    unit = options.unit
+    if unit == "auto":
+        unit = "s" if tname is not None and first[tname][0] in FLOAT_DATATYPES else "ns"
+    header_ns = stamp_ns(msg.header)
+    try:
+        d = _io.decode_pointcloud2(
+            _data(msg),
+            width=int(msg.width),
+            height=int(msg.height),
+            point_step=int(msg.point_step),
+            row_step=int(msg.row_step),
+            big_endian=bool(msg.is_bigendian),
+            fields=fields,
+            intensity_field=inten_name or "",
+            time_field=tname or "",
+            time_ns_per_unit=NS_PER_UNIT[unit],
+            header_ns=header_ns,
+            header_s=header_ns / NS_PER_S,
+            absolute_time_min_s=ABSOLUTE_TIME_MIN_S,
+            where=where,
+        )
+    except InputError as e:
+        raise CloudError(str(e)) from None
     offsets = None
     header_is_end = options.header_stamp == "end"
     if tname is not None:
-        if pts.dtype[tname].shape:
-            raise CloudError(f"{where}: time field '{tname}' has count {pts.dtype[tname].shape[0]}; expected 1")
-        offsets = _offsets_s(pts[tname][keep], header_ns, tname, options, where)
+        offsets = d.offset_s
         if offsets.size:
-            lo, hi = float(offsets.min()), float(offsets.max())
+            _check_span(d, tname, first[tname][0], unit, where)
+            lo, hi = d.offset_min_s, d.offset_max_s
             if options.header_stamp == "auto":
                 header_is_end = hi <= HEADER_END_TOLERANCE_S and lo < -HEADER_END_TOLERANCE_S
             elif header_is_end and lo >= 0.0:
                 offsets = offsets - hi  # offsets from the start, header at the end: end = last point
             elif not header_is_end and hi <= 0.0:
                 offsets = offsets - lo
-    return Cloud(header_ns, xyz, intensity, offsets, header_is_end, str(getattr(msg.header, "frame_id", "")))
+    intensity = d.intensity if inten_name else None
+    return Cloud(header_ns, d.points, intensity, offsets, header_is_end, str(getattr(msg.header, "frame_id", "")))
 
 
 def time_field_of(msg: Any, options: TimeOptions | None = None) -> str | None:

@@ -86,6 +86,10 @@ def encode(
             "itemsize": off + padding,
         }
     )
+    fields = [(n, o, POINTFIELD_CODES[t]) for (n, t), o in zip(names, offsets)]
+    if len(names) == len("xyz") and not padding:  # x, y, z only: the bytes of the (N, 3) float32 points
+        data = np.ascontiguousarray(points, dtype=np.float32).view(np.uint8).reshape(-1)
+        return EncodedCloud(header_ns, fields, dtype.itemsize, data)
     arr = np.zeros(len(points), dtype=dtype)
     for k, c in enumerate("xyz"):
         arr[c] = points[:, k]
@@ -98,5 +102,4 @@ def encode(
         else:
             rel_ns = np.round(t * NS_PER_S) + (start_ns - header_ns)
             arr[conv.field] = rel_ns / conv.ns_per_unit if conv.ns_per_unit > 1 else np.round(rel_ns)
-    fields = [(n, o, POINTFIELD_CODES[t]) for (n, t), o in zip(names, offsets)]
     return EncodedCloud(header_ns, fields, dtype.itemsize, arr.view(np.uint8).reshape(-1))

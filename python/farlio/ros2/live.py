@@ -252,7 +252,7 @@ class LiveOdometry:
         self._last_scan_end = scan.end_stamp_ns
         self._arrivals[scan.end_stamp_ns] = arrival
         self.stats.scans += 1
-        self.odometry.add_scan(scan)  # a busy worker reports the scan as dropped
+        self.odometry.add_scan(scan, consume=True)  # moved in, not copied; a busy worker reports it as dropped
 
     def _imu_ready(self, arrival: int) -> bool:
         """Whether scans may go to the odometry: an IMU sample has come, or none is expected, or

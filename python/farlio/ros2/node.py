@@ -31,6 +31,7 @@ from farlio import _core
 
 from ..datasets.calib import CalibFile
 from . import conversions as conv
+from . import retain_freed_memory
 from .live import FrameReport, LiveOdometry
 from .params import NODE_NAME, NodeParams, config_from, config_param_docs, node_param_docs, node_params_from
 
@@ -63,6 +64,10 @@ class FarlioNode(Node):
             keep_registered_points=self.params.publish_cloud_registered,
         )
         self._gyro_bias = [0.0, 0.0, 0.0]
+        # the odometry messages, filled again for every pose: one for the executor thread (fused
+        # odometry), one for the result thread (scan odometry, and the odometry when LiDAR-only)
+        self._fused_out = conv.ReusedOdometry(self.params.odom_frame, self.params.base_frame)
+        self._scan_out = conv.ReusedOdometry(self.params.odom_frame, self.params.base_frame)
         self._map_frames = 0  # processed frames when the local map was last published
         self._last_map_ns = 0
         self._make_publishers()
@@ -146,17 +151,22 @@ class FarlioNode(Node):
 
     def _on_imu(self, msg: Imu) -> None:
         for s in self.live.add_imu(conv.imu_sample(msg)):
-            self._publish_odometry(s.stamp_ns, s.body_pose, s.velocity_body_m_s, self._angular_velocity())
+            self._publish_odometry(
+                self._fused_out, s.stamp_ns, s.body_pose, s.velocity_body_m_s, self._angular_velocity()
+            )
 
     def _angular_velocity(self) -> list[float]:
         return [float(w - b) for w, b in zip(self.live.last_gyro_rad_s, self._gyro_bias)]
 
-    def _publish_odometry(self, stamp: int, pose: farlio.SE3, velocity: Any = None, angular: Any = None) -> None:
-        if not conv.is_finite_pose(pose):
+    def _publish_odometry(
+        self, out: conv.ReusedOdometry, stamp: int, pose: farlio.SE3, velocity: Any = None, angular: Any = None
+    ) -> None:
+        """Publishes the odometry (and TF) through `out`, the message of the calling thread."""
+        if not out.fill(stamp, pose, velocity, angular):
             self.live.report("poses_non_finite", f"non-finite odometry pose at {stamp} ns not published")
             return
         p = self.params
-        self._odom_pub.publish(conv.odometry_msg(stamp, pose, p.odom_frame, p.base_frame, velocity, angular))
+        self._odom_pub.publish(out.msg)
         if self._tf_pub is not None:
             self._tf_pub.publish(TFMessage(transforms=[conv.transform_msg(stamp, pose, p.odom_frame, p.base_frame)]))
 
@@ -174,14 +184,14 @@ class FarlioNode(Node):
     def _publish_frame(self, report: FrameReport) -> None:
         f, p = report.frame, self.params
         stamp = f.scan.stamp_ns
-        ok = f.processed and conv.is_finite_pose(f.body_pose)
+        ok = f.processed and self._scan_out.fill(stamp, f.body_pose)
         if f.processed and not ok:
             self.live.report("poses_non_finite", f"non-finite scan pose at {stamp} ns not published")
         if ok:
-            self._scan_pub.publish(conv.odometry_msg(stamp, f.body_pose, p.odom_frame, p.base_frame))
+            self._scan_pub.publish(self._scan_out.msg)
             report.done_ns = time.monotonic_ns()  # the latency ends with the scan odometry out
             if not self.live.odometry.inertial:  # LiDAR-only: the odometry at the scan rate
-                self._publish_odometry(stamp, f.body_pose)
+                self._publish_odometry(self._scan_out, stamp, f.body_pose)
             if p.publish_cloud_registered:
                 self._cloud_pub.publish(conv.points_msg(f.registered_points, stamp, p.odom_frame))
         stats = self.live.odometry.fusion_stats
@@ -271,12 +281,15 @@ class FarlioNode(Node):
 def run(ros_args: list[str], transport: str = "") -> int:
     """`farlio ros2 [--ros-args ...]`: runs the node until SIGINT (or the context shuts down);
     `transport` says which DDS transport settings are in use (for the log)."""
+    memory_kept = retain_freed_memory()  # before the first cloud's buffers
     rclpy.init(args=[NODE_NAME, *ros_args])
     node = None
     try:
         node = FarlioNode()
         if transport:
             node.get_logger().info(f"transport: {transport}")
+        if not memory_kept:
+            node.get_logger().info("the allocator is not glibc's: its own policy for freed memory applies")
         executor = SingleThreadedExecutor()
         executor.add_node(node)
         executor.spin()
