@@ -26,6 +26,8 @@ SUMMARY_KEYS = [
     "dropped",
     "registered",
     "degenerate",
+    "registration_failed",
+    "map_restarts",
     "converged_fraction",
     "latency_ms",
     "wall_s",
