@@ -97,8 +97,8 @@ inline constexpr double kMaxVoxelCapacity = 2147483647.0;
   FIELD(double, degenerate_rotation_std_rad, 0.01, range::positive(),                                               \
         "a body-frame axis whose rotation std exceeds this is degenerate")                                          \
   FIELD(bool, hold_degenerate_directions, true, range::unchecked(),                                                 \
-        "Gauss-Newton does not move the pose along degenerate directions (they stay at the prediction) and the "    \
-        "fusion takes them from the IMU; false: the scan's weak constraint is used as it is")                       \
+        "LIO: Gauss-Newton does not move the pose along degenerate directions (they stay at the IMU prediction) "   \
+        "and the fusion takes them from the IMU; false, or LiDAR-only: the scan's weak constraint is used")         \
   FIELD(int, min_inliers, 100, range::at_least(1),                                                                  \
         "a registration with fewer correspondences has failed: the scan keeps the predicted pose and updates "      \
         "neither the map, the adaptive threshold nor the fusion")                                                   \
