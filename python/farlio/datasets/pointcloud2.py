@@ -17,7 +17,8 @@ Per-point time conventions found in the wild (all handled by `TimeOptions` 'auto
 'auto' reads float fields as seconds and integer fields as nanoseconds; values above
 ABSOLUTE_TIME_MIN_S seconds are absolute times, others are offsets from the header stamp.
 Offsets that are all <= 0 mean that the header stamp is the scan END (Velodyne's newer drivers).
-A time span longer than MAX_SCAN_SPAN_S is rejected as an unknown unit, naming the field.
+A time span longer than MAX_SCAN_SPAN_S is rejected as an unknown unit, naming the field (the rule
+is the C++ one every loader uses: farlio._core.io.point_time_span_plausible, docs/io.md).
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ from typing import Any
 
 import numpy as np
 
+from farlio import _core
 from farlio._core import NS_PER_S
 
 #: PointField datatype codes (sensor_msgs/PointField) -> numpy type
@@ -41,8 +43,8 @@ TIME_UNITS = ("auto", *NS_PER_UNIT)
 HEADER_STAMPS = ("auto", "start", "end")
 #: time values (in s) above this are absolute (Unix) times, not offsets (1e6 s is 11.6 days)
 ABSOLUTE_TIME_MIN_S = 1e6
-#: a scan lasting longer than this means the time unit was misread
-MAX_SCAN_SPAN_S = 1.0
+#: a scan lasting longer than this means the time unit was misread (the limit of every loader)
+MAX_SCAN_SPAN_S = _core.io.MAX_SCAN_SPAN_S
 #: offsets within this of 0 still count as "<= 0" when deciding that the header is the scan end
 HEADER_END_TOLERANCE_S = 1e-6
 
@@ -175,7 +177,7 @@ def _offsets_s(values: np.ndarray, header_ns: int, name: str, options: TimeOptio
     else:
         offsets = values.astype(np.float64) * scale
     span = (hi - lo) * scale
-    if not np.isfinite(span) or span > MAX_SCAN_SPAN_S:
+    if not _core.io.point_time_span_plausible(span):
         raise CloudError(
             f"{where}: time field '{name}' ({values.dtype}) spans {hi - lo:g} raw units, which in "
             f"{unit} is {span:g} s, longer than a scan can last ({MAX_SCAN_SPAN_S:g} s): unknown time "
