@@ -47,6 +47,8 @@ ABSOLUTE_TIME_MIN_S = 1e6
 MAX_SCAN_SPAN_S = _core.io.MAX_SCAN_SPAN_S
 #: offsets within this of 0 still count as "<= 0" when deciding that the header is the scan end
 HEADER_END_TOLERANCE_S = 1e-6
+#: bytes of one point at most (drivers use tens; numpy's structured types end at 2^31)
+MAX_POINT_STEP = 1 << 16
 
 
 class CloudError(ValueError):
@@ -102,6 +104,8 @@ def field_names(msg: Any) -> list[str]:
 
 def cloud_dtype(msg: Any, where: str) -> np.dtype:
     """The structured dtype of one point: every field at its offset, itemsize point_step."""
+    if not 0 < int(msg.point_step) <= MAX_POINT_STEP:
+        raise CloudError(f"{where}: point_step {msg.point_step} is not in 1..{MAX_POINT_STEP} bytes")
     order = ">" if msg.is_bigendian else "<"
     names, formats, offsets = [], [], []
     for f in msg.fields:
@@ -136,6 +140,10 @@ def structured_points(msg: Any, where: str) -> np.ndarray:
     )
     row_bytes = int(msg.width) * int(msg.point_step)
     row_step = int(msg.row_step) or row_bytes
+    if msg.height > 1 and row_step < row_bytes:
+        raise CloudError(
+            f"{where}: row_step {row_step} is shorter than a row of {msg.width} points of {msg.point_step} bytes"
+        )
     needed = (int(msg.height) - 1) * row_step + row_bytes if n else 0
     if data.size < needed:
         raise CloudError(
