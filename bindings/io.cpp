@@ -10,6 +10,7 @@
 #include "bindings.hpp"
 #include "farlio/io/calibration.hpp"
 #include "farlio/io/point_cloud_io.hpp"
+#include "farlio/io/point_times.hpp"
 #include "farlio/io/rigid_transform.hpp"
 #include "farlio/io/sequence.hpp"
 #include "farlio/io/trajectory_io.hpp"
@@ -36,6 +37,18 @@ TrajectoryFormat format_from(const std::string& name) {
   std::string names;
   for (const auto& entry : kTrajectoryFormatNames) names += (names.empty() ? "" : ", ") + std::string(entry.first);
   throw nb::value_error(("unknown trajectory format '" + name + "'; use one of " + names).c_str());
+}
+
+/// Calls read(&warnings) and issues each warning as a Python UserWarning (the CLI prints them as
+/// "farlio: warning: ..."); a warnings filter that turns them into errors raises.
+template <class Read>
+auto with_python_warnings(Read&& read) {
+  Warnings warnings;
+  auto result = read(&warnings);
+  for (const auto& w : warnings) {
+    if (PyErr_WarnEx(PyExc_UserWarning, w.c_str(), 1) != 0) throw nb::python_error();
+  }
+  return result;
 }
 
 nb::tuple trajectory_format_names() {
@@ -73,29 +86,45 @@ void bind_point_clouds(nb::module_& m) {
       },
       "path"_a, "scan"_a, "Binary little endian PLY of the scan's points (and intensity if present).");
   m.def("write_kitti_bin", &write_kitti_bin, "path"_a, "scan"_a, "KITTI .bin: float32 x y z intensity.");
+  m.attr("MAX_SCAN_SPAN_S") = kMaxScanSpan_s;
+  m.def("point_time_span_plausible", &point_time_span_plausible, "span_s"_a,
+        "Whether per-point times spanning span_s seconds can belong to one scan (finite, at most MAX_SCAN_SPAN_S).");
+  m.def("check_point_times", &check_point_times, "scan"_a, "what"_a,
+        "InputError '<what>: <problem>' when the scan's per-point times cannot be seconds since its start: a span "
+        "over MAX_SCAN_SPAN_S (a unit read wrong), times before the start or past its duration (end - start).");
 }
 
 void bind_trajectories(nb::module_& m) {
-  m.def("read_tum", &read_tum, "path"_a);
+  m.def(
+      "read_tum", [](const Path& path) { return with_python_warnings([&](Warnings* w) { return read_tum(path, w); }); },
+      "path"_a, "A TUM file; a torn last line (no newline, does not parse) is skipped with a UserWarning.");
   m.def("write_tum", &write_tum, "path"_a, "trajectory"_a);
   m.def(
       "read_kitti",
       [](const Path& path, const std::optional<std::vector<std::int64_t>>& stamps_ns) {
-        return read_kitti(path, stamps_ns ? &*stamps_ns : nullptr);
+        return with_python_warnings(
+            [&](Warnings* w) { return read_kitti(path, stamps_ns ? &*stamps_ns : nullptr, w); });
       },
-      "path"_a, "stamps_ns"_a = nb::none(), "KITTI 3x4 poses; without stamps pose i gets i * 100 ms.");
+      "path"_a, "stamps_ns"_a = nb::none(),
+      "KITTI 3x4 poses; without stamps pose i gets i * 100 ms. A torn last line is skipped with a UserWarning.");
   m.def("write_kitti", &write_kitti, "path"_a, "trajectory"_a);
-  m.def("read_stamps", &read_stamps, "path"_a,
-        "A times file: the first field of each line, seconds -> integer ns (exact for plain decimals).");
+  m.def(
+      "read_stamps",
+      [](const Path& path) { return with_python_warnings([&](Warnings* w) { return read_stamps(path, w); }); },
+      "path"_a,
+      "A times file: the first field of each line, seconds -> integer ns (exact for plain decimals); a torn last "
+      "line is skipped with a UserWarning.");
   m.attr("TRAJECTORY_FORMATS") = trajectory_format_names();
   m.def(
       "read_trajectory",
       [](const Path& path, const std::string& format, const std::optional<Path>& times) {
-        return read_trajectory(path, format_from(format), times);
+        const TrajectoryFormat f = format_from(format);
+        return with_python_warnings([&](Warnings* w) { return read_trajectory(path, f, times, w); });
       },
       "path"_a, "format"_a = "auto", "times"_a = nb::none(),
       "A TUM or KITTI file ('auto': by the column count, 8 or 12); KITTI poses are stamped from the times "
-      "file (read_stamps), without one pose i gets i * 100 ms.");
+      "file (read_stamps), without one pose i gets i * 100 ms. A torn last line (no newline, does not parse) "
+      "is skipped with a UserWarning naming the file and line.");
   nb::class_<TrajectoryWriter>(m, "TrajectoryWriter", "Appends TUM lines, flushing each one.")
       .def(nb::init<const Path&>(), "path"_a)
       .def("append", &TrajectoryWriter::append, "stamp_ns"_a, "pose"_a)

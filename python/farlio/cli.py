@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import sys
+import warnings
 
 # name -> (module, help). Each module provides add_arguments(parser) and run(args) -> int.
 COMMANDS = {
@@ -48,7 +49,14 @@ ROS_ARGS = "--ros-args"
 ROS_COMMANDS = ("ros2", "ros2-play")
 
 
+def show_warning(message, category, filename, lineno, file=None, line=None) -> None:  # noqa: ARG001
+    """Warnings of the library (e.g. a trajectory reader skipping a torn last line) as one line
+    "farlio: warning: ..." on stderr, like the CLI's own warnings, not as Python source locations."""
+    print(f"farlio: warning: {message}", file=file or sys.stderr)
+
+
 def main(argv: list[str] | None = None) -> int:
+    warnings.showwarning = show_warning
     argv = list(sys.argv[1:] if argv is None else argv)
     ros_args = argv[argv.index(ROS_ARGS) :] if ROS_ARGS in argv else []
     args = build_parser().parse_args(argv[: len(argv) - len(ros_args)])

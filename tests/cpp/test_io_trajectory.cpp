@@ -179,3 +179,72 @@ TEST(TrajectoryFile, ReadsEitherFormatWithItsStamps) {
   test::expect_input_error([&] { (void)read_trajectory(kitti, TrajectoryFormat::kAuto, times); }, kitti,
                            "20 poses but 2 stamps");
 }
+
+// A run that filled the disk or died mid-line leaves a torn last line without a newline: it is
+// skipped with a warning naming the file and line; the same line in the middle stays an error.
+TEST(TornLastLine, SkippedWithAWarningInEveryTrajectoryReader) {
+  TempDir tmp;
+  const auto tum = tmp.path() / "odometry_body.tum";
+  test::write_raw(tum, "# t x y z qx qy qz qw\n1.0 1 2 3 0 0 0 1\n2.0 4 5 6 0 0 0 1\n3.0 7 8");
+  Warnings warnings;
+  const Trajectory t = read_tum(tum, &warnings);
+  ASSERT_EQ(t.size(), 2u);
+  EXPECT_EQ(t[1].stamp_ns, 2'000'000'000);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("odometry_body.tum:4: last line skipped"), std::string::npos) << warnings[0];
+  EXPECT_EQ(read_trajectory(tum, TrajectoryFormat::kAuto).size(), 2u);  // without a list: to std::cerr
+
+  // With its newline the same line was written whole: an error.
+  test::write_raw(tum, "1.0 1 2 3 0 0 0 1\n2.0 4 5 6 0 0 0 1\n3.0 7 8\n");
+  test::expect_input_error([&] { (void)read_tum(tum); }, tum, "odometry_body.tum:3");
+  // A bad line in the middle stays an error even when the last line is torn.
+  test::write_raw(tum, "1.0 1 2 3 0 0 0 1\n2.0 4 x 6 0 0 0 1\n3.0 7 8");
+  test::expect_input_error([&] { (void)read_tum(tum); }, tum, "odometry_body.tum:2");
+  // A whole last line without a newline is read as before.
+  test::write_raw(tum, "1.0 1 2 3 0 0 0 1\n2.0 4 5 6 0 0 0 1");
+  EXPECT_EQ(read_tum(tum).size(), 2u);
+
+  const auto kitti = tmp.path() / "poses.txt";
+  test::write_raw(kitti, "1 0 0 1 0 1 0 2 0 0 1 3\n1 0 0 4 0 1 0 5 0 0 1 6\n1 0 0 7 0 1");
+  warnings.clear();
+  EXPECT_EQ(read_kitti(kitti, nullptr, &warnings).size(), 2u);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("poses.txt:3"), std::string::npos) << warnings[0];
+  // The times file may still hold the torn pose's stamp.
+  const std::vector<std::int64_t> stamps = {10, 20, 30};
+  const Trajectory stamped = read_kitti(kitti, &stamps, &warnings);
+  ASSERT_EQ(stamped.size(), 2u);
+  EXPECT_EQ(stamped[1].stamp_ns, 20);
+  EXPECT_EQ(read_trajectory(kitti, TrajectoryFormat::kAuto, std::nullopt, &warnings).size(), 2u);
+
+  const auto times = tmp.path() / "times.txt";
+  test::write_raw(times, "0.1\n0.2\n0.3e");
+  warnings.clear();
+  EXPECT_EQ(read_stamps(times, &warnings), (std::vector<std::int64_t>{100'000'000, 200'000'000}));
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("times.txt:3"), std::string::npos) << warnings[0];
+}
+
+// The writers say why a write failed and name the file (/dev/full: "No space left on device").
+TEST(WriteErrors, NameTheFileAndTheReason) {
+  const std::filesystem::path full = "/dev/full";
+  if (!std::filesystem::exists(full)) GTEST_SKIP() << "no /dev/full";
+  auto expect_reason = [&](auto&& write) {
+    try {
+      write();
+      ADD_FAILURE() << "no error writing to " << full;
+    } catch (const std::runtime_error& e) {
+      const std::string msg = e.what();
+      EXPECT_NE(msg.find("/dev/full: write error: No space left on device"), std::string::npos) << msg;
+    }
+  };
+  const Trajectory tr = random_trajectory(3, 6, 0);
+  expect_reason([&] { TrajectoryWriter w(full); });
+  expect_reason([&] { write_tum(full, tr); });
+  expect_reason([&] { write_kitti(full, tr); });
+  expect_reason([&] {
+    OutputFile out(full);
+    out.write(std::string_view("1.0 0 0 0 0 0 0 1\n"));  // buffered: fails at the flush
+    out.flush();
+  });
+}

@@ -249,3 +249,28 @@ def test_kitti_layout_is_stamped_at_times_txt_and_evaluates_against_its_ground_t
         late.push_back(stamp + DEFAULT_PERIOD_NS, pose)
     core.io.write_tum(tmp_path / "late.tum", late)
     assert ape(tmp_path / "late.tum")["translation_m"]["rmse"] > KITTI_LATE_APE_MIN_M
+
+
+@pytest.mark.parametrize(
+    ("name", "scale", "shift", "found"),
+    [
+        ("ns_as_seconds", 1e9, 0.0, "their unit is not seconds"),
+        ("five_periods", 5.0, 0.0, "but the scan lasts 0.1 s"),
+        ("relative_to_end", 1.0, -0.1, "before the scan start"),
+    ],
+)
+def test_point_cloud_folder_checks_per_point_times(tmp_path, name, scale, shift, found):
+    """The folder path checks per-point times with the check of every loader (check_point_times):
+    times in ns stored as seconds, spanning 5 scan periods, or negative are rejected naming the file."""
+    rng = np.random.default_rng(7)
+    stamps = [1_700_000_000_000_000_000 + k * DEFAULT_PERIOD_NS for k in range(3)]
+    for k, stamp in enumerate(stamps):
+        times = np.sort(rng.uniform(0.0, 0.099, 200)).astype(np.float32)
+        if k == 1:
+            times = (times * scale + shift).astype(np.float32)
+        scan = farlio.Scan(rng.uniform(-20, 20, (200, 3)).astype(np.float32), time_s=times)
+        farlio._core.io.write_pcd(tmp_path / f"{stamp}.pcd", scan)
+    ds = open_dataset(tmp_path)
+    assert len(ds.scan(0)) == 200 and len(ds.scan(2)) == 200
+    with pytest.raises(ValueError, match=rf"{stamps[1]}\.pcd: per-point times .*{found}"):
+        ds.scan(1)

@@ -112,3 +112,42 @@ def test_times_files_and_trajectories_by_format(tmp_path: Path) -> None:
     with pytest.raises(core.InputError, match="times.txt:2"):
         (tmp_path / "times.txt").write_text("1.0\nnope\n")
         io.read_stamps(tmp_path / "times.txt")
+
+
+def test_torn_last_line_is_skipped_with_a_warning(tmp_path: Path) -> None:
+    """A disk-full run leaves a partial last line: the readers skip it with a UserWarning naming
+    the file and line, and `farlio eval` evaluates the rest (it used to reject the whole file)."""
+    est = tmp_path / "odometry_body.tum"
+    lines = [f"{k}.0 {k} 0 0 0 0 0 1" for k in range(1, 6)]
+    est.write_text("\n".join(lines) + "\n6.0 6 0")
+    with pytest.warns(UserWarning, match=r"odometry_body\.tum:6: last line skipped"):
+        traj = io.read_trajectory(est)
+    assert len(traj) == 5
+    gt = tmp_path / "gt.tum"
+    gt.write_text("\n".join(lines) + "\n")
+    # a bad line in the middle is still an error
+    bad = tmp_path / "bad.tum"
+    bad.write_text("\n".join([lines[0], "2.0 x", *lines[2:]]) + "\n6.0 6 0")
+    with pytest.raises(ValueError, match=r"bad\.tum:2"):
+        io.read_trajectory(bad)
+
+
+def test_eval_cli_warns_about_a_torn_line_and_evaluates(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    from farlio import cli
+
+    lines = [f"{k}.0 {k} {k * k * 0.1} 0 0 0 0 1" for k in range(1, 11)]
+    est, gt = tmp_path / "est.tum", tmp_path / "gt.tum"
+    est.write_text("\n".join(lines) + "\n11.0 11 12.1 0 0")
+    gt.write_text("\n".join(lines) + "\n")
+    assert cli.main(["eval", str(est), str(gt), "--out", str(tmp_path / "out")]) == 0
+    err = capsys.readouterr().err
+    assert "farlio: warning: " in err and "est.tum:11: last line skipped" in err
+
+
+def test_trajectory_writer_says_why_a_write_failed() -> None:
+    if not Path("/dev/full").exists():
+        pytest.skip("no /dev/full")
+    with pytest.raises(RuntimeError, match="/dev/full: write error: No space left on device"):
+        io.TrajectoryWriter("/dev/full")
+    with pytest.raises(RuntimeError, match="/dev/full: write error: No space left on device"):
+        io.write_tum("/dev/full", core.Trajectory())

@@ -120,12 +120,15 @@ const SE3& Calibration::lidar_extrinsic(const std::vector<std::string>& names) c
 }
 
 Calibration read_calibration(const std::filesystem::path& path) {
+  const Bytes bytes = read_file_bytes(path);
+  return parse_calibration(std::string(bytes.begin(), bytes.end()), path);
+}
+
+Calibration parse_calibration(const std::string& text, const std::filesystem::path& path) {
   const std::string file = path.string();
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throw InputError(file + ": no such file");
   YAML::Node root;
   try {
-    root = YAML::LoadFile(file);
+    root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     throw InputError(file + ": not valid YAML (" + e.what() + ")");
   }

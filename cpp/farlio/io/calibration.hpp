@@ -37,6 +37,8 @@ struct Calibration {
 /// Throws InputError naming the file (and the key, e.g. T_imu_lidar[/front]) if it is missing,
 /// not YAML, lacks T_imu_lidar, or a value is malformed (e.g. not 4x4 or not a rigid transform).
 [[nodiscard]] Calibration read_calibration(const std::filesystem::path& path);
+/// The same on the text of a file in memory; `path` names it in errors and becomes `source`.
+[[nodiscard]] Calibration parse_calibration(const std::string& text, const std::filesystem::path& path);
 /// Writes what read_calibration reads back: the mapping form when T_imu_lidar_by_name is not
 /// empty, gravity only when stated.
 void write_calibration(const std::filesystem::path& path, const Calibration& calib);

@@ -40,6 +40,10 @@ std::vector<ImuSample> read_imu_csv(const std::filesystem::path& path, std::vect
   if (!std::filesystem::is_regular_file(path, ec)) throw InputError(file + ": no such file");
   std::ifstream in(path);
   if (!in) throw InputError(file + ": cannot open file");
+  return parse_imu_csv(in, file, warnings);
+}
+
+std::vector<ImuSample> parse_imu_csv(std::istream& in, const std::string& file, std::vector<std::string>& warnings) {
   std::string line;
   std::size_t line_no = 0;
   // Header: the first non-blank line.

@@ -16,10 +16,11 @@ constexpr ScalarType kFloat32{ScalarKind::Float, sizeof(float)};
 constexpr bool kLittleEndian = false;  // the `big_endian` argument of load_scalar
 }  // namespace
 
-Scan read_kitti_bin(const std::filesystem::path& path) {
-  const Bytes bytes = read_file_bytes(path);
+Scan read_kitti_bin(const std::filesystem::path& path) { return parse_kitti_bin(read_file_bytes(path), path.string()); }
+
+Scan parse_kitti_bin(ByteView bytes, const std::string& file) {
   if (bytes.size() % kBytesPerPoint != 0) {
-    throw InputError(path.string() + ": size " + std::to_string(bytes.size()) + " bytes is not a multiple of " +
+    throw InputError(file + ": size " + std::to_string(bytes.size()) + " bytes is not a multiple of " +
                      std::to_string(kBytesPerPoint) + " (float32 x y z intensity per point; truncated?)");
   }
   const std::size_t n = bytes.size() / kBytesPerPoint;

@@ -20,6 +20,9 @@ constexpr unsigned kHashBits = 14;
 constexpr std::size_t kHashSize = std::size_t{1} << kHashBits;
 constexpr std::uint32_t kHashMultiplier = 2654435761u;  // Knuth's multiplicative hash
 constexpr std::size_t kNoEntry = static_cast<std::size_t>(-1);
+// The most output one input byte can give: a long back-reference (3 bytes) copies kMaxMatch bytes.
+constexpr std::size_t kLongReferenceBytes = 3;
+constexpr std::size_t kMaxExpansion = kMaxMatch / kLongReferenceBytes;  // 88
 
 std::size_t hash3(const unsigned char* p) {
   const std::uint32_t v = (std::uint32_t{p[0]} << 16) | (std::uint32_t{p[1]} << 8) | p[2];
@@ -102,6 +105,11 @@ std::vector<unsigned char> lzf_compress(std::span<const unsigned char> in) {
 }
 
 std::vector<unsigned char> lzf_decompress(std::span<const unsigned char> in, std::size_t expected_size) {
+  // Checked before reserving, so that a size field cannot make us allocate what the data cannot fill.
+  if (in.size() < expected_size / kMaxExpansion) {
+    throw LzfError("LZF data of " + std::to_string(in.size()) + " bytes cannot expand to " +
+                   std::to_string(expected_size) + " bytes (at most " + std::to_string(kMaxExpansion) + " times)");
+  }
   std::vector<unsigned char> out;
   out.reserve(expected_size);
   std::size_t ip = 0;

@@ -23,8 +23,9 @@ class LzfError : public std::runtime_error {
 /// grows by at most one byte in 32 plus one.
 [[nodiscard]] std::vector<unsigned char> lzf_compress(std::span<const unsigned char> in);
 
-/// Decompresses `in`, which must expand to exactly `expected_size` bytes. Throws LzfError on a
-/// reference before the start of the output, a chunk running past the input, or a size mismatch.
+/// Decompresses `in`, which must expand to exactly `expected_size` bytes. Throws LzfError on an
+/// `expected_size` over 88 times the input (the most LZF can expand; checked before allocating),
+/// a reference before the start of the output, a chunk running past the input, or a size mismatch.
 [[nodiscard]] std::vector<unsigned char> lzf_decompress(std::span<const unsigned char> in, std::size_t expected_size);
 
 }  // namespace farlio::io

@@ -1,11 +1,11 @@
 #include "farlio/io/pcd_header.hpp"
 
-#include <limits>
 #include <optional>
 #include <sstream>
 #include <string_view>
 
 #include "farlio/core/error.hpp"
+#include "farlio/io/size_limits.hpp"
 #include "farlio/io/text_number.hpp"
 
 namespace farlio::io {
@@ -39,7 +39,7 @@ char pcd_letter(ScalarKind kind) {
 
 class HeaderParser {
  public:
-  HeaderParser(const Bytes& bytes, std::string file) : bytes_(bytes), file_(std::move(file)) {}
+  HeaderParser(ByteView bytes, std::string file) : bytes_(bytes), file_(std::move(file)) {}
 
   PcdHeader parse() {
     std::size_t pos = 0;
@@ -138,20 +138,33 @@ class HeaderParser {
         fail("field '" + names_[k] + "' has unsupported TYPE " + types_[k] + " with SIZE " + std::to_string(size_[k]));
       }
       if (count_[k] == 0) fail("field '" + names_[k] + "' has COUNT 0");
+      require_within_limit(count_[k], kMaxFieldCount, file_,
+                           "COUNT " + std::to_string(count_[k]) + " of field '" + names_[k] + "'");
       h_.fields.push_back({names_[k], *type, count_[k]});
+      // SIZE <= 8 and COUNT <= kMaxFieldCount: the product fits, the sum is checked.
+      const auto record = checked_add(h_.record_bytes, type->size_bytes * count_[k]);
+      if (!record) fail("the record size (sum of SIZE * COUNT over the fields) overflows");
+      h_.record_bytes = *record;
     }
     h_.width = *width_;
-    if (h_.height != 0 && h_.width > std::numeric_limits<std::size_t>::max() / h_.height) {
-      fail("WIDTH * HEIGHT overflows");
+    require_within_limit(h_.width, kMaxCloudPoints, file_, "WIDTH " + std::to_string(h_.width));
+    require_within_limit(h_.height, kMaxCloudPoints, file_, "HEIGHT " + std::to_string(h_.height));
+    const auto wh = checked_mul(h_.width, h_.height);
+    if (!wh) fail("WIDTH * HEIGHT overflows");
+    require_within_limit(*wh, kMaxCloudPoints, file_, "WIDTH * HEIGHT = " + std::to_string(*wh) + " points");
+    if (points_ && *points_ != *wh) {
+      fail("POINTS " + std::to_string(*points_) + " differs from WIDTH * HEIGHT = " + std::to_string(*wh));
     }
-    const std::size_t wh = h_.width * h_.height;
-    if (points_ && *points_ != wh) {
-      fail("POINTS " + std::to_string(*points_) + " differs from WIDTH * HEIGHT = " + std::to_string(wh));
+    h_.points = *wh;
+    const auto data = checked_mul(h_.points, h_.record_bytes);
+    if (!data) {
+      fail(std::to_string(h_.points) + " points of " + std::to_string(h_.record_bytes) +
+           " bytes each overflow the size of the data");
     }
-    h_.points = wh;
+    h_.data_bytes = *data;
   }
 
-  const Bytes& bytes_;
+  ByteView bytes_;
   std::string file_;
   std::size_t line_ = 0;
   PcdHeader h_;
@@ -167,13 +180,7 @@ class HeaderParser {
 
 }  // namespace
 
-std::size_t PcdHeader::record_bytes() const {
-  std::size_t b = 0;
-  for (const auto& f : fields) b += f.type.size_bytes * f.count;
-  return b;
-}
-
-PcdHeader parse_pcd_header(const Bytes& bytes, const std::string& file) { return HeaderParser(bytes, file).parse(); }
+PcdHeader parse_pcd_header(ByteView bytes, const std::string& file) { return HeaderParser(bytes, file).parse(); }
 
 std::string format_pcd_header(const std::vector<FieldSpec>& fields, std::size_t points, PcdEncoding encoding) {
   std::ostringstream h;

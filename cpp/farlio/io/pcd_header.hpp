@@ -18,14 +18,14 @@ struct PcdHeader {
   PcdEncoding encoding = PcdEncoding::Binary;
   std::size_t data_offset = 0;   ///< first byte after the DATA line
   std::size_t header_lines = 0;  ///< lines up to and including the DATA line
-
-  /// Bytes of one point (sum of SIZE * COUNT).
-  [[nodiscard]] std::size_t record_bytes() const;
+  std::size_t record_bytes = 0;  ///< bytes of one point (sum of SIZE * COUNT)
+  std::size_t data_bytes = 0;    ///< bytes of all points (points * record_bytes) in the binary encodings
 };
 
 /// Parses the header at the start of `bytes`; throws InputError naming `file` on a missing,
-/// unknown or malformed key or on inconsistent FIELDS/SIZE/TYPE/COUNT/WIDTH/HEIGHT/POINTS.
-[[nodiscard]] PcdHeader parse_pcd_header(const Bytes& bytes, const std::string& file);
+/// unknown or malformed key, on inconsistent FIELDS/SIZE/TYPE/COUNT/WIDTH/HEIGHT/POINTS, on a
+/// COUNT, WIDTH, HEIGHT or POINTS over its limit (size_limits.hpp) and on sizes that overflow.
+[[nodiscard]] PcdHeader parse_pcd_header(ByteView bytes, const std::string& file);
 
 /// The header text for `fields` and `points` points in one row.
 [[nodiscard]] std::string format_pcd_header(const std::vector<FieldSpec>& fields, std::size_t points,

@@ -28,7 +28,7 @@ std::vector<std::size_t> field_offsets(const std::vector<FieldSpec>& fields, std
   return off;
 }
 
-Scan read_ascii(const Bytes& bytes, const PcdHeader& h, const ChannelMap& m, const std::string& file) {
+Scan read_ascii(ByteView bytes, const PcdHeader& h, const ChannelMap& m, const std::string& file) {
   std::size_t values_per_point = 0;
   for (const auto& f : h.fields) values_per_point += f.count;
   std::vector<std::size_t> column(h.fields.size());
@@ -71,17 +71,17 @@ Scan read_ascii(const Bytes& bytes, const PcdHeader& h, const ChannelMap& m, con
     throw InputError(file + ": header says " + std::to_string(h.points) + " points but data holds " +
                      std::to_string(got) + " (truncated?)");
   }
-  return assemble_scan(h.points, m,
+  return assemble_scan(h.points, m, file,
                        [&](std::size_t i, std::size_t k) { return values[i * values_per_point + column[k]]; });
 }
 
-Scan read_binary(const Bytes& bytes, const PcdHeader& h, const ChannelMap& m, const std::string& file) {
-  const std::size_t record = h.record_bytes();
+Scan read_binary(ByteView bytes, const PcdHeader& h, const ChannelMap& m, const std::string& file) {
+  const std::size_t record = h.record_bytes;  // > 0: every field has SIZE >= 1 and COUNT >= 1
   const std::size_t available = bytes.size() - h.data_offset;
-  const std::size_t needed = h.points * record;
+  const std::size_t needed = h.data_bytes;
   if (available < needed) {
     throw InputError(file + ": header says " + std::to_string(h.points) + " points but data holds " +
-                     std::to_string(record == 0 ? 0 : available / record) + " (truncated?)");
+                     std::to_string(available / record) + " (truncated?)");
   }
   if (available > needed) {
     throw InputError(file + ": data holds " + std::to_string(available - needed) + " bytes more than the " +
@@ -89,12 +89,12 @@ Scan read_binary(const Bytes& bytes, const PcdHeader& h, const ChannelMap& m, co
   }
   const auto off = field_offsets(h.fields, 1);
   const unsigned char* base = bytes.data() + h.data_offset;
-  return assemble_scan(h.points, m, [&](std::size_t i, std::size_t k) {
+  return assemble_scan(h.points, m, file, [&](std::size_t i, std::size_t k) {
     return load_scalar(base + i * record + off[k], h.fields[k].type, kLittleEndian);
   });
 }
 
-Scan read_binary_compressed(const Bytes& bytes, const PcdHeader& h, const ChannelMap& m, const std::string& file) {
+Scan read_binary_compressed(ByteView bytes, const PcdHeader& h, const ChannelMap& m, const std::string& file) {
   const std::size_t available = bytes.size() - h.data_offset;
   if (available < kCompressedPrefixBytes) {
     throw InputError(file + ": binary_compressed data lacks its 8-byte size prefix (truncated?)");
@@ -102,7 +102,7 @@ Scan read_binary_compressed(const Bytes& bytes, const PcdHeader& h, const Channe
   const unsigned char* base = bytes.data() + h.data_offset;
   const auto compressed = static_cast<std::size_t>(load_scalar(base, kUint32, kLittleEndian));
   const auto uncompressed = static_cast<std::size_t>(load_scalar(base + sizeof(std::uint32_t), kUint32, kLittleEndian));
-  const std::size_t needed = h.points * h.record_bytes();
+  const std::size_t needed = h.data_bytes;
   if (uncompressed != needed) {
     throw InputError(file + ": header says " + std::to_string(h.points) + " points (" + std::to_string(needed) +
                      " bytes) but the compressed block expands to " + std::to_string(uncompressed) + " bytes");
@@ -118,7 +118,7 @@ Scan read_binary_compressed(const Bytes& bytes, const PcdHeader& h, const Channe
     throw InputError(file + ": corrupt binary_compressed data: " + e.what());
   }
   const auto off = field_offsets(h.fields, h.points);  // structure of arrays
-  return assemble_scan(h.points, m, [&](std::size_t i, std::size_t k) {
+  return assemble_scan(h.points, m, file, [&](std::size_t i, std::size_t k) {
     const auto& f = h.fields[k];
     return load_scalar(raw.data() + off[k] + i * f.count * f.type.size_bytes, f.type, kLittleEndian);
   });
@@ -126,9 +126,9 @@ Scan read_binary_compressed(const Bytes& bytes, const PcdHeader& h, const Channe
 
 }  // namespace
 
-Scan read_pcd(const std::filesystem::path& path) {
-  const std::string file = path.string();
-  const Bytes bytes = read_file_bytes(path);
+Scan read_pcd(const std::filesystem::path& path) { return parse_pcd(read_file_bytes(path), path.string()); }
+
+Scan parse_pcd(ByteView bytes, const std::string& file) {
   const PcdHeader h = parse_pcd_header(bytes, file);
   const ChannelMap m = map_channels(h.fields, file);
   switch (h.encoding) {

@@ -1,5 +1,6 @@
 // Reading PLY files (ascii 1.0, binary_little_endian 1.0, binary_big_endian 1.0). The "vertex"
 // element gives the points; every other element (faces, edges, ...) is skipped, before or after it.
+#include <cmath>
 #include <string>
 #include <string_view>
 
@@ -7,6 +8,7 @@
 #include "farlio/io/file_bytes.hpp"
 #include "farlio/io/point_cloud_io.hpp"
 #include "farlio/io/point_fields.hpp"
+#include "farlio/io/size_limits.hpp"
 #include "farlio/io/text_number.hpp"
 
 namespace farlio::io {
@@ -36,7 +38,7 @@ struct PlyHeader {
 constexpr std::string_view kVertex = "vertex";
 constexpr std::size_t kMaxListLength = std::size_t{1} << 20;  // a sanity bound on corrupt counts
 
-PlyHeader parse_header(const Bytes& bytes, const std::string& file) {
+PlyHeader parse_header(ByteView bytes, const std::string& file) {
   PlyHeader h;
   std::size_t pos = 0;
   std::size_t line_no = 0;
@@ -80,7 +82,11 @@ PlyHeader parse_header(const Bytes& bytes, const std::string& file) {
       if (tok.size() != 3) fail("expected 'element <name> <count>'");
       const auto n = parse_int64(tok[2]);
       if (!n || *n < 0) fail("element count '" + std::string(tok[2]) + "' is not a non-negative integer");
-      h.elements.push_back({std::string(tok[1]), static_cast<std::size_t>(*n), {}});
+      const auto count = static_cast<std::size_t>(*n);
+      require_within_limit(count, kMaxCloudPoints, file,
+                           "header line " + std::to_string(line_no) + ": count " + std::to_string(count) +
+                               " of element '" + std::string(tok[1]) + "'");
+      h.elements.push_back({std::string(tok[1]), count, {}});
     } else if (key == "property") {
       if (h.elements.empty()) fail("property before any element");
       PlyProperty p;
@@ -109,7 +115,7 @@ PlyHeader parse_header(const Bytes& bytes, const std::string& file) {
 /// Sequential reader of scalars from the data section, ascii tokens or binary bytes.
 class PlyCursor {
  public:
-  PlyCursor(const Bytes& bytes, const PlyHeader& h, std::string file) : file_(std::move(file)), format_(h.format) {
+  PlyCursor(ByteView bytes, const PlyHeader& h, std::string file) : file_(std::move(file)), format_(h.format) {
     data_ = bytes.data() + h.data_offset;
     size_ = bytes.size() - h.data_offset;
     if (format_ == PlyFormat::Ascii) {
@@ -160,9 +166,9 @@ std::size_t min_instance_size(const PlyElement& e, bool ascii) {
 
 }  // namespace
 
-Scan read_ply(const std::filesystem::path& path) {
-  const std::string file = path.string();
-  const Bytes bytes = read_file_bytes(path);
+Scan read_ply(const std::filesystem::path& path) { return parse_ply(read_file_bytes(path), path.string()); }
+
+Scan parse_ply(ByteView bytes, const std::string& file) {
   const PlyHeader h = parse_header(bytes, file);
   const PlyElement* vertex = nullptr;
   for (const auto& e : h.elements) {
@@ -179,21 +185,24 @@ Scan read_ply(const std::filesystem::path& path) {
   const std::size_t np = vertex->properties.size();
   for (const auto& e : h.elements) {
     const bool is_vertex = &e == vertex;
+    if (e.properties.empty()) continue;  // instances without properties hold no data (and may be many)
     // Reject counts the data cannot hold before allocating anything for them.
-    const std::size_t min_size = min_instance_size(e, cur.is_ascii());
-    if (min_size != 0 && e.count > cur.remaining() / min_size) {
+    const std::size_t min_size = min_instance_size(e, cur.is_ascii());  // >= 1: there is a property
+    if (e.count > cur.remaining() / min_size) {
       throw InputError(file + ": header says " + std::to_string(e.count) + " " + e.name + " elements but data holds " +
                        std::to_string(cur.remaining() / min_size) + " (truncated?)");
     }
-    if (is_vertex) values.resize(e.count * np);
+    if (is_vertex) values.resize(e.count * np);  // np <= min_size, so at most remaining() values
     for (std::size_t i = 0; i < e.count; ++i) {
       for (std::size_t k = 0; k < e.properties.size(); ++k) {
         const auto& p = e.properties[k];
         auto where = [&] { return "element '" + e.name + "' " + std::to_string(i) + " of " + std::to_string(e.count); };
         if (p.is_list) {
           const double len = cur.next(p.count_type, where());
-          if (len < 0 || len > static_cast<double>(kMaxListLength)) {
-            throw InputError(file + ": " + where() + ": list length " + std::to_string(len) + " is not plausible");
+          // Written so that NaN fails too; ascii text may hold any number.
+          if (!(len >= 0 && len <= static_cast<double>(kMaxListLength)) || std::floor(len) != len) {
+            throw InputError(file + ": " + where() + ": list length " + std::to_string(len) +
+                             " is not an integer in 0.." + std::to_string(kMaxListLength));
           }
           for (std::size_t j = 0; j < static_cast<std::size_t>(len); ++j) (void)cur.next(p.type, where());
         } else {
@@ -207,7 +216,7 @@ Scan read_ply(const std::filesystem::path& path) {
     throw InputError(file + ": " + std::to_string(cur.remaining()) + (cur.is_ascii() ? " values" : " bytes") +
                      " after the last element (header and data disagree)");
   }
-  return assemble_scan(vertex->count, m, [&](std::size_t i, std::size_t k) { return values[i * np + k]; });
+  return assemble_scan(vertex->count, m, file, [&](std::size_t i, std::size_t k) { return values[i * np + k]; });
 }
 
 }  // namespace farlio::io

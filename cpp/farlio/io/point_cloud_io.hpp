@@ -6,6 +6,8 @@
 // naming the file; a file that cannot be written throws std::runtime_error naming it.
 #include <filesystem>
 #include <optional>
+#include <span>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -27,6 +29,11 @@ enum class PcdEncoding { Ascii, Binary, BinaryCompressed };
 [[nodiscard]] Scan read_pcd(const std::filesystem::path& path);
 [[nodiscard]] Scan read_ply(const std::filesystem::path& path);
 [[nodiscard]] Scan read_kitti_bin(const std::filesystem::path& path);
+
+/// The same readers on the bytes of a file in memory (not gzip'd); `file` names them in errors.
+[[nodiscard]] Scan parse_pcd(std::span<const unsigned char> bytes, const std::string& file);
+[[nodiscard]] Scan parse_ply(std::span<const unsigned char> bytes, const std::string& file);
+[[nodiscard]] Scan parse_kitti_bin(std::span<const unsigned char> bytes, const std::string& file);
 
 /// Fields x y z [intensity] [t] float32 and [sensor_id] uint8, each written only if the scan has it.
 void write_pcd(const std::filesystem::path& path, const Scan& scan, PcdEncoding encoding = PcdEncoding::Binary);

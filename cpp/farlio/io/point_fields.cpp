@@ -1,6 +1,8 @@
 #include "farlio/io/point_fields.hpp"
 
 #include <array>
+#include <cmath>
+#include <limits>
 #include <string_view>
 
 #include "farlio/core/error.hpp"
@@ -50,6 +52,15 @@ ChannelMap map_channels(const std::vector<FieldSpec>& fields, const std::string&
   }
   m.time_in_ns = m.time && fields[*m.time].type.is_integer();
   return m;
+}
+
+std::uint8_t sensor_id_value(double v, std::size_t point, const std::string& file) {
+  constexpr double kMaxSensorId = std::numeric_limits<std::uint8_t>::max();
+  if (!(v >= 0.0 && v <= kMaxSensorId) || std::floor(v) != v) {
+    throw InputError(file + ": field 'sensor_id' of point " + std::to_string(point) + " is " + std::to_string(v) +
+                     ", not an integer in 0..255");
+  }
+  return static_cast<std::uint8_t>(v);
 }
 
 }  // namespace farlio::io

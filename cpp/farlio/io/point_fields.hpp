@@ -33,9 +33,13 @@ struct ChannelMap {
 /// Throws InputError naming `file` if x, y or z is missing or a used field has a COUNT other than 1.
 [[nodiscard]] ChannelMap map_channels(const std::vector<FieldSpec>& fields, const std::string& file);
 
+/// A sensor_id value as stored: throws InputError naming `file`, the point and the value unless
+/// it is an integer in 0..255.
+[[nodiscard]] std::uint8_t sensor_id_value(double v, std::size_t point, const std::string& file);
+
 /// Builds a scan of `n` points; get(i, field_index) returns point i's value of a field (element 0).
 template <class Get>
-Scan assemble_scan(std::size_t n, const ChannelMap& m, Get&& get) {
+Scan assemble_scan(std::size_t n, const ChannelMap& m, const std::string& file, Get&& get) {
   Scan s;
   s.points.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
@@ -53,7 +57,7 @@ Scan assemble_scan(std::size_t n, const ChannelMap& m, Get&& get) {
   }
   if (m.sensor_id) {
     s.sensor_id.resize(n);
-    for (std::size_t i = 0; i < n; ++i) s.sensor_id[i] = static_cast<std::uint8_t>(get(i, *m.sensor_id));
+    for (std::size_t i = 0; i < n; ++i) s.sensor_id[i] = sensor_id_value(get(i, *m.sensor_id), i, file);
   }
   return s;
 }

@@ -30,7 +30,8 @@ class SequenceReader {
   /// scan uses the next difference; a lone scan uses its largest point time).
   [[nodiscard]] std::int64_t scan_start_stamp_ns(std::size_t i) const;
   [[nodiscard]] const std::filesystem::path& scan_path(std::size_t i) const;
-  /// Scan i with its stamps set.
+  /// Scan i with its stamps set; InputError naming its file when its per-point times cannot be
+  /// seconds since its start (check_point_times).
   [[nodiscard]] Scan read_scan(std::size_t i) const;
 
   [[nodiscard]] bool has_imu() const { return has_imu_; }

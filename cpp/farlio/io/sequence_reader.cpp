@@ -6,6 +6,7 @@
 #include "farlio/core/error.hpp"
 #include "farlio/core/time.hpp"
 #include "farlio/io/imu_csv.hpp"
+#include "farlio/io/point_times.hpp"
 #include "farlio/io/sequence.hpp"
 #include "farlio/io/text_number.hpp"
 #include "farlio/io/trajectory_io.hpp"
@@ -116,6 +117,7 @@ Scan SequenceReader::read_scan(std::size_t i) const {
   s.end_stamp_ns = scans_[i].end_stamp_ns;
   s.start_stamp_ns = scans_.size() > 1 ? scan_start_stamp_ns(i) : s.end_stamp_ns - max_time_ns(s);
   s.validate(scans_[i].path.string());
+  check_point_times(s, scans_[i].path.string());
   return s;
 }
 

@@ -82,8 +82,18 @@ class _FilesWithStamps(Dataset):
         return len(self._files)
 
     def scan(self, i: int) -> farlio.Scan:
-        period = self._stamps[i] - self._stamps[i - 1] if i > 0 else DEFAULT_PERIOD_NS
-        return _with_stamps(_core.io.read_point_cloud(self._files[i]), self._stamps[i] - period, self._stamps[i])
+        """Scan i, starting one period before its stamp (the gap to the previous stamp; for the
+        first scan the gap to the next, as SequenceReader does); its per-point times are checked
+        (_core.io.check_point_times, the check of every loader)."""
+        if i > 0:
+            period = self._stamps[i] - self._stamps[i - 1]
+        elif len(self._stamps) > 1:
+            period = self._stamps[1] - self._stamps[0]
+        else:
+            period = DEFAULT_PERIOD_NS
+        scan = _with_stamps(_core.io.read_point_cloud(self._files[i]), self._stamps[i] - period, self._stamps[i])
+        _core.io.check_point_times(scan, str(self._files[i]))
+        return scan
 
     def scan_source(self, i: int) -> str:
         return str(self._files[i])
@@ -116,7 +126,9 @@ class KittiOdometry(_FilesWithStamps):
         self._gt: Path | None = None
 
     def scan(self, i: int) -> farlio.Scan:
-        return _with_stamps(_core.io.read_point_cloud(self._files[i]), self._stamps[i], self._stamps[i])
+        scan = _with_stamps(_core.io.read_point_cloud(self._files[i]), self._stamps[i], self._stamps[i])
+        _core.io.check_point_times(scan, str(self._files[i]))
+        return scan
 
     def groundtruth(self) -> Path | None:
         src = self.path / GROUNDTRUTH_KITTI

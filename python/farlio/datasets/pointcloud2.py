@@ -19,7 +19,8 @@ Per-point time conventions found in the wild (all handled by `TimeOptions` 'auto
 'auto' reads float fields as seconds and integer fields as nanoseconds; values above
 ABSOLUTE_TIME_MIN_S seconds are absolute times, others are offsets from the header stamp.
 Offsets that are all <= 0 mean that the header stamp is the scan END (Velodyne's newer drivers).
-A time span longer than MAX_SCAN_SPAN_S is rejected as an unknown unit, naming the field.
+A time span longer than MAX_SCAN_SPAN_S is rejected as an unknown unit, naming the field (the rule
+is the C++ one every loader uses: farlio._core.io.point_time_span_plausible, docs/io.md).
 """
 
 from __future__ import annotations
@@ -47,7 +48,7 @@ HEADER_STAMPS = ("auto", "start", "end")
 #: time values (in s) above this are absolute (Unix) times, not offsets (1e6 s is 11.6 days)
 ABSOLUTE_TIME_MIN_S = 1e6
 #: a scan lasting longer than this means the time unit was misread
-MAX_SCAN_SPAN_S = 1.0
+MAX_SCAN_SPAN_S = _io.MAX_SCAN_SPAN_S
 #: offsets within this of 0 still count as "<= 0" when deciding that the header is the scan end
 HEADER_END_TOLERANCE_S = 1e-6
 
@@ -128,7 +129,7 @@ def _check_span(points: Any, name: str, datatype: int, unit: str, where: str) ->
     """A scan lasts at most MAX_SCAN_SPAN_S: a longer span of the time field means a wrong unit."""
     lo, hi = points.time_min, points.time_max
     span = (hi - lo) * NS_PER_UNIT[unit] / NS_PER_S
-    if not np.isfinite(span) or span > MAX_SCAN_SPAN_S:
+    if not _io.point_time_span_plausible(span):
         raise CloudError(
             f"{where}: time field '{name}' ({np.dtype(POINTFIELD_TYPES[datatype]).name}) spans {hi - lo:g} raw "
             f"units, which in {unit} is {span:g} s, longer than a scan can last ({MAX_SCAN_SPAN_S:g} s): unknown "
