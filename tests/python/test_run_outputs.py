@@ -25,6 +25,7 @@ SUMMARY_KEYS = [
     "skipped",
     "dropped",
     "registered",
+    "fused",
     "degenerate",
     "converged_fraction",
     "latency_ms",

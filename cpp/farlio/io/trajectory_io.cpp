@@ -33,6 +33,20 @@ std::string tum_line(std::int64_t stamp_ns, const SE3& pose) {
   return s;
 }
 
+/// The 3x4 row-major [R | t] of a KITTI line.
+std::string kitti_line(const SE3& pose) {
+  const Mat4d m = pose.matrix();
+  std::string s;
+  for (int r = 0; r < kKittiRows; ++r) {
+    for (int c = 0; c < kKittiCols; ++c) {
+      if (r || c) s += ' ';
+      s += format_number(m(r, c));
+    }
+  }
+  s += '\n';
+  return s;
+}
+
 std::ifstream open_for_reading(const std::filesystem::path& path) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path.string() + ": no such file");
@@ -165,26 +179,19 @@ Trajectory read_trajectory(const std::filesystem::path& path, TrajectoryFormat f
 
 void write_kitti(const std::filesystem::path& path, const Trajectory& trajectory) {
   std::string text;
-  for (const auto& p : trajectory) {
-    const Mat4d m = p.pose.matrix();
-    for (int r = 0; r < kKittiRows; ++r) {
-      for (int c = 0; c < kKittiCols; ++c) {
-        if (r || c) text += ' ';
-        text += format_number(m(r, c));
-      }
-    }
-    text += '\n';
-  }
+  for (const auto& p : trajectory) text += kitti_line(p.pose);
   write_text_file(path, text);
 }
 
-TrajectoryWriter::TrajectoryWriter(const std::filesystem::path& path) : path_(path), out_(path, std::ios::trunc) {
+TrajectoryWriter::TrajectoryWriter(const std::filesystem::path& path, TrajectoryFormat format)
+    : path_(path), kitti_(format == TrajectoryFormat::kKitti), out_(path, std::ios::trunc) {
+  if (format == TrajectoryFormat::kAuto) throw std::invalid_argument(path.string() + ": write TUM or KITTI, not auto");
   if (!out_) throw std::runtime_error(path.string() + ": cannot open for writing");
-  out_ << kTumHeader << std::flush;
+  if (!kitti_) out_ << kTumHeader << std::flush;
 }
 
 void TrajectoryWriter::append(std::int64_t stamp_ns, const SE3& pose) {
-  out_ << tum_line(stamp_ns, pose) << std::flush;
+  out_ << (kitti_ ? kitti_line(pose) : tum_line(stamp_ns, pose)) << std::flush;
   if (!out_) throw std::runtime_error(path_.string() + ": write error");
   ++count_;
 }
