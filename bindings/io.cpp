@@ -125,8 +125,16 @@ void bind_trajectories(nb::module_& m) {
       "A TUM or KITTI file ('auto': by the column count, 8 or 12); KITTI poses are stamped from the times "
       "file (read_stamps), without one pose i gets i * 100 ms. A torn last line (no newline, does not parse) "
       "is skipped with a UserWarning naming the file and line.");
-  nb::class_<TrajectoryWriter>(m, "TrajectoryWriter", "Appends TUM lines, flushing each one.")
-      .def(nb::init<const Path&>(), "path"_a)
+  nb::class_<TrajectoryWriter>(m, "TrajectoryWriter", "Appends TUM (or KITTI) lines, flushing each one.")
+      .def(
+          "__init__",
+          [](TrajectoryWriter* w, const Path& path, const std::string& format) {
+            const auto f = parse_trajectory_format(format);
+            if (!f || *f == TrajectoryFormat::kAuto)
+              throw nb::value_error("TrajectoryWriter: format must be tum or kitti");
+            new (w) TrajectoryWriter(path, *f);
+          },
+          "path"_a, "format"_a = "tum")
       .def("append", &TrajectoryWriter::append, "stamp_ns"_a, "pose"_a)
       .def("__len__", &TrajectoryWriter::size)
       .def_prop_ro("path", &TrajectoryWriter::path);

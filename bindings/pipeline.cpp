@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "bindings.hpp"
+#include "farlio/core/clock_check.hpp"
 #include "farlio/core/config_fields.hpp"
 #include "farlio/pipeline/odometry.hpp"
 #include "farlio/pipeline/online_odometry.hpp"
@@ -229,6 +230,19 @@ void bind_pipeline(nb::module_& m) {
       nb::call_guard<nb::gil_scoped_release>(),
       "T_target_source by sparsity-aware GICP (the target becomes a voxel map).");
 
+  nb::class_<ClockCheck>(m, "ClockCheck", "Whether the IMU and the scans share a clock (check_clocks).")
+      .def_ro("error", &ClockCheck::error, "empty when the spans overlap, else what was found")
+      .def_ro("warnings", &ClockCheck::warnings);
+  m.def(
+      "check_clocks",
+      [](std::int64_t imu_first_ns, std::int64_t imu_last_ns, std::int64_t scan_first_ns, std::int64_t scan_last_ns,
+         double tolerance_s) {
+        return check_clocks({imu_first_ns, imu_last_ns}, {scan_first_ns, scan_last_ns}, tolerance_s);
+      },
+      "imu_first_ns"_a, "imu_last_ns"_a, "scan_first_ns"_a, "scan_last_ns"_a, "tolerance_s"_a,
+      "Compares the IMU's stamp span with the scans': an error when they do not overlap (naming the unit that "
+      "would make them), warnings when the IMU starts late or ends early by more than tolerance_s.");
+
   nb::enum_<pipeline::LatencyModel>(m, "LatencyModel")
       .value("Measured", pipeline::LatencyModel::Measured)
       .value("Zero", pipeline::LatencyModel::Zero)
@@ -302,6 +316,9 @@ void bind_pipeline(nb::module_& m) {
           },
           "[(stamp_ns, body pose)] of the 10 ms odometry output since the last call.")
       .def_prop_ro("inertial", [](const PyOdometry& o) { return o.odometry.inertial(); })
+      .def(
+          "take_warnings", [](PyOdometry& o) { return o.odometry.take_warnings(); },
+          "What was tolerated since the last call (sorted IMU, an unusable IMU, a reset of the fusion).")
       .def_prop_ro(
           "effective_config", [](const PyOdometry& o) { return o.odometry.scan_pipeline().config(); },
           "The parameters in use (the voxel size is fixed at the first scan when auto).")
@@ -359,6 +376,9 @@ void bind_pipeline(nb::module_& m) {
           nb::call_guard<nb::gil_scoped_release>(),
           "(N, 3) float32 copy of the submap's points (world frame); waits for the scan in progress")
       .def_prop_ro("inertial", [](PyOnlineOdometry& o) { return o.odometry.inertial(); })
+      .def(
+          "take_warnings", [](PyOnlineOdometry& o) { return o.odometry.take_warnings(); },
+          "The warnings since the last call (a reset of the fusion, the gyro's unit, an unusable IMU).")
       .def_prop_ro(
           "device", [](PyOnlineOdometry& o) { return device_name(o.odometry.device()); },
           "'cpu' or 'cuda': the backend the scan pipeline runs on")

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import signal
 import sys
 import warnings
 
@@ -55,6 +56,24 @@ def show_warning(message, category, filename, lineno, file=None, line=None) -> N
     print(f"farlio: warning: {message}", file=file or sys.stderr)
 
 
+class _Termination:
+    """SIGTERM handled as SIGINT (a KeyboardInterrupt, so that a run writes its summary before it
+    ends), remembering which signal came for the exit status (128 + its number)."""
+
+    def __init__(self) -> None:
+        self.signal = signal.SIGINT
+
+    def __call__(self, signum: int, frame: object) -> None:  # noqa: ARG002
+        self.signal = signal.Signals(signum)
+        raise KeyboardInterrupt
+
+
+#: what a command raises for bad input or a failing file: one line, exit status 2
+EXPECTED_ERRORS = (ValueError, OSError, RuntimeError)
+#: the exit status of a run ended by a signal is 128 + its number (130 for SIGINT, 143 for SIGTERM)
+SIGNAL_EXIT_BASE = 128
+
+
 def main(argv: list[str] | None = None) -> int:
     warnings.showwarning = show_warning
     argv = list(sys.argv[1:] if argv is None else argv)
@@ -64,12 +83,18 @@ def main(argv: list[str] | None = None) -> int:
         print(f"farlio {args.command}: error: {ROS_ARGS} is for {' and '.join(ROS_COMMANDS)}", file=sys.stderr)
         return 2
     args.ros_args = ros_args
+    termination = _Termination()
+    if args.command not in ROS_COMMANDS:  # the ROS 2 commands handle their own shutdown
+        signal.signal(signal.SIGTERM, termination)
     try:
         return int(importlib.import_module(args._module).run(args) or 0)
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
-        return 130
-    except (ValueError, OSError, RuntimeError) as e:  # InputError is a ValueError
+        return SIGNAL_EXIT_BASE + termination.signal
+    except MemoryError as e:
+        print(f"farlio {args.command}: error: out of memory ({e or 'an allocation failed'})", file=sys.stderr)
+        return 2
+    except EXPECTED_ERRORS as e:  # InputError is a ValueError
         print(f"farlio {args.command}: error: {e}", file=sys.stderr)
         return 2
 

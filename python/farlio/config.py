@@ -26,11 +26,21 @@ def _flatten(d: dict, prefix: str = "") -> dict[str, Any]:
     return out
 
 
+def _yaml_error_place(path: Path, error: yaml.YAMLError) -> str:
+    """file:line of a YAML error (the file alone when the parser gives no line)."""
+    mark = getattr(error, "problem_mark", None)
+    return f"{path}:{mark.line + 1}" if mark is not None else str(path)
+
+
 def load_config(yaml_path: Path | None = None, overrides: Iterable[str] = ()) -> Config:
     """Defaults, then the YAML file, then `key=value` overrides (later wins)."""
     cfg = Config()
     if yaml_path is not None:
-        data = yaml.safe_load(Path(yaml_path).read_text()) or {}
+        try:
+            data = yaml.safe_load(Path(yaml_path).read_text()) or {}
+        except yaml.YAMLError as e:
+            problem = getattr(e, "problem", None) or e
+            raise ValueError(f"{_yaml_error_place(yaml_path, e)}: not valid YAML ({problem})") from None
         if not isinstance(data, dict):
             raise ValueError(f"{yaml_path}: expected a mapping of config fields")
         for name, value in _flatten(data).items():

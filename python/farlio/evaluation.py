@@ -15,6 +15,7 @@ from typing import Any
 
 from farlio import _core
 from farlio._core import NS_PER_S
+from farlio.cli_args import non_negative_float, positive_float, positive_int
 
 #: trajectory file formats ("auto": TUM or KITTI by the column count), as the C++ reader names them
 FORMATS = tuple(_core.io.TRAJECTORY_FORMATS)
@@ -212,12 +213,14 @@ def add_eval_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--format", dest="fmt", choices=FORMATS, default="auto", help="trajectory file format")
     parser.add_argument("--times", type=Path, help="KITTI times file (seconds a line), used for both files")
     parser.add_argument("--scan-stamps", type=Path, help="file of scan stamps in seconds (coverage reference)")
-    parser.add_argument("--max-time-diff", type=float, default=0.01, help="association tolerance [s]")
+    parser.add_argument("--max-time-diff", type=non_negative_float, default=0.01, help="association tolerance [s]")
     parser.add_argument("--nearest", action="store_true", help="nearest-stamp association (no interpolation)")
     parser.add_argument("--align-scale", action="store_true", help="Sim(3) alignment for the aligned APE")
-    parser.add_argument("--kitti-step", type=int, default=1, help="first frame every N frames (KITTI devkit: 10)")
-    parser.add_argument("--segments", type=float, nargs="+", help="KITTI segment lengths [m] (default: auto)")
-    parser.add_argument("--rpe-delta", type=float, default=1.0, help="evo-style RPE pair distance")
+    parser.add_argument(
+        "--kitti-step", type=positive_int, default=1, help="first frame every N frames (KITTI devkit: 10)"
+    )
+    parser.add_argument("--segments", type=positive_float, nargs="+", help="KITTI segment lengths [m] (default: auto)")
+    parser.add_argument("--rpe-delta", type=positive_float, default=1.0, help="evo-style RPE pair distance")
     parser.add_argument("--rpe-unit", choices=RPE_UNITS, default="frames", help="unit of --rpe-delta")
     parser.add_argument("--rpe-all-pairs", action="store_true", help="all pairs instead of consecutive ones")
     parser.add_argument("--no-plot", action="store_true", help="skip eval.png")

@@ -4,10 +4,11 @@ Outputs in the output folder (every trajectory file names its frame):
   scans_lidar.tum        registered LiDAR pose at every scan end (TUM; flushed per frame)
   scans_body.tum         registered body (IMU) pose at every scan end = LiDAR pose * T_imu_lidar^-1
   odometry_body.tum      the fused 100 Hz body odometry (LIO only; flushed as it goes)
-  scans_lidar_kitti.txt  LiDAR poses relative to the first (KITTI 3x4), written at the end
+  scans_lidar_kitti.txt  LiDAR poses relative to the first (KITTI 3x4; flushed per frame)
   timing.csv             per-frame stage timings (stage_clock: wall or cuda_events), counts and what
                          happened to the frame (flushed)
-  summary.json           frames, median/p99 latency, converged fraction, accuracy with ground truth
+  summary.json           frames, median/p99 latency, converged fraction, accuracy with ground truth;
+                         written also when the run is interrupted (SIGINT, SIGTERM: "interrupted": true)
   config.yaml            the full effective parameter set
   eval_scans/, eval_odometry/   eval.json + eval.png against the ground truth, when there is one
   map.ply, map.pcd       the final submap, world frame (with --save-map)
@@ -91,8 +92,11 @@ def run_dataset(
     result) is called after every processed scan (a live view)."""
     run = OdometryRun(dataset, Path(out_dir), config or _core.Config())
     run.open_outputs(options or replay_options(), use_imu)
-    run.run_frames(max_frames, progress, on_frame)
-    run.export_kitti()
+    try:
+        run.run_frames(max_frames, progress, on_frame)
+    except KeyboardInterrupt:  # SIGINT, or SIGTERM through the CLI: what was done so far is kept
+        run.write_summary(run.summarise() | {"interrupted": True})
+        raise
     if save_map:
         run.save_map()
     summary = run.summarise()
@@ -109,6 +113,7 @@ class FrameCounts:
 
     totals_ms: list[float] = field(default_factory=list)  # processing time of every processed frame
     registered: int = 0
+    fused: int = 0
     converged: int = 0
     skipped: int = 0
     dropped: int = 0
@@ -127,6 +132,7 @@ class OdometryRun:
         self.lidar_poses = farlio.Trajectory()
         self.last_stamp: int | None = None
         self.wall_s = 0.0
+        self.imu_span: tuple[int, int] | None = None  # first and last IMU stamp, when the IMU is used
 
     def open_outputs(self, options: Any, use_imu: bool) -> None:
         """config.yaml (written first so that a run that dies still says its parameters; rewritten
@@ -136,7 +142,12 @@ class OdometryRun:
         for w in self.dataset.warnings():
             _warn(w)
         imu = self.dataset.imu() if use_imu else []
+        if imu and self.config.get("fusion.enabled"):
+            imu_stamps = [s.stamp_ns for s in imu]
+            self.imu_span = (min(imu_stamps), max(imu_stamps))
+            self.check_clocks()
         self.odo = _core.Odometry(self.config, self.dataset.T_imu_lidar(), self.dataset.gravity_m_s2(), imu, options)
+        self.warn_from_odometry()
         if self.odo.device_message:
             print(f"farlio: {self.odo.device_message}", file=sys.stderr)
         elif self.odo.device == "cuda":
@@ -147,7 +158,40 @@ class OdometryRun:
             )
         self.lidar_tum = _core.io.TrajectoryWriter(self.out_dir / SCANS_LIDAR_TUM)
         self.body_tum = _core.io.TrajectoryWriter(self.out_dir / SCANS_BODY_TUM)
+        self.lidar_kitti = _core.io.TrajectoryWriter(self.out_dir / SCANS_LIDAR_KITTI, "kitti")
         self.odom_tum = _core.io.TrajectoryWriter(self.out_dir / ODOMETRY_TUM) if self.odo.inertial else None
+
+    def clock_check(self, first_scan_ns: int, last_scan_ns: int) -> Any:
+        """The IMU's stamp span against the scans' (_core.check_clocks)."""
+        tolerance_s = self.config.get("fusion.max_bridged_gap_s")
+        return _core.check_clocks(*self.imu_span, first_scan_ns, last_scan_ns, tolerance_s)
+
+    def check_clocks(self) -> None:
+        """Stops before the run when the IMU's stamps and the scans' do not overlap (different
+        clocks or units: the error says which unit would fit); warns when the IMU starts late or
+        ends early. Needs the scan stamps without reading the scans (folders; not bags, whose run
+        warns at the end when no scan could be fused)."""
+        stamps = self.dataset.scan_end_stamps_ns()
+        if not stamps:
+            return
+        check = self.clock_check(min(stamps), max(stamps))
+        if check.error:
+            raise ValueError(f"{self.dataset.path}: {check.error}")
+        for w in check.warnings:
+            _warn(w)
+
+    def warn_if_nothing_fused(self) -> None:
+        """A run with an IMU in which no scan reached the fusion (its clock is not the scans')."""
+        if self.imu_span is None or self.counts.fused or len(self.lidar_poses) == 0:
+            return
+        check = self.clock_check(self.lidar_poses[0][0], self.lidar_poses[len(self.lidar_poses) - 1][0])
+        _warn("no scan was fused with the IMU" + (f": {check.error}" if check.error else ""))
+
+    def warn_from_odometry(self) -> None:
+        """What the odometry tolerated since the last call (sorted IMU, a reset of the fusion, the
+        gyro's unit, an unusable IMU)."""
+        for w in self.odo.take_warnings():
+            _warn(w)
 
     def run_frames(
         self, max_frames: int | None, progress: bool | None, on_frame: Callable[[int, Any, Any], None] | None
@@ -155,14 +199,18 @@ class OdometryRun:
         self.frames = len(self.dataset) if max_frames is None else min(len(self.dataset), max_frames)
         bar = Progress(self.frames, self.dataset.name, progress)
         start = time.perf_counter()
-        with TimingCsv(self.out_dir / TIMING_CSV) as timing:
-            for i in range(self.frames):
-                self.run_frame(i, timing, bar, on_frame)
-            if self.last_stamp is not None:
-                self.odo.finish(self.last_stamp)
-                self.write_odometry()
-        bar.close()
-        self.wall_s = time.perf_counter() - start
+        try:
+            with TimingCsv(self.out_dir / TIMING_CSV) as timing:
+                for i in range(self.frames):
+                    self.run_frame(i, timing, bar, on_frame)
+                if self.last_stamp is not None:
+                    self.odo.finish(self.last_stamp)
+                    self.write_odometry()
+        finally:
+            bar.close()
+            self.wall_s = time.perf_counter() - start
+        self.warn_from_odometry()
+        self.warn_if_nothing_fused()
 
     def run_frame(
         self, i: int, timing: TimingCsv, bar: Progress, on_frame: Callable[[int, Any, Any], None] | None
@@ -173,6 +221,7 @@ class OdometryRun:
         fr = self.odo.process(scan)
         self.last_stamp = scan.end_stamp_ns
         self.write_odometry()
+        self.warn_from_odometry()
         timing.write(i, scan, fr)
         if not fr.processed:
             self.counts.dropped += 1
@@ -214,25 +263,17 @@ class OdometryRun:
         r = fr.scan
         self.lidar_tum.append(r.stamp_ns, r.pose)
         self.body_tum.append(r.stamp_ns, fr.body_pose)
+        first = self.lidar_poses[0][1] if len(self.lidar_poses) else r.pose
+        self.lidar_kitti.append(r.stamp_ns, first.inverse() * r.pose)  # relative to the first
         self.lidar_poses.push_back(r.stamp_ns, r.pose)
         self.counts.totals_ms.append(r.timings.total_s * MS_PER_S)
         self.counts.registered += int(r.registered)
+        self.counts.fused += int(fr.fused)
         self.counts.converged += int(r.registered and r.converged and not r.failure)
         self.counts.failed += int(bool(r.failure))
         self.counts.map_restarts += int(r.map_restarted)
         self.counts.dropped += int(bool(fr.drop_reason))
         self.counts.degenerate += int(fr.degeneracy is not None and fr.degeneracy.degenerate)
-
-    def export_kitti(self) -> None:
-        """LiDAR poses relative to the first, KITTI 3x4."""
-        if len(self.lidar_poses) == 0:
-            return
-        first_inv = self.lidar_poses[0][1].inverse()
-        relative = farlio.Trajectory()
-        for k in range(len(self.lidar_poses)):
-            stamp, pose = self.lidar_poses[k]
-            relative.push_back(stamp, first_inv * pose)
-        _core.io.write_kitti(self.out_dir / SCANS_LIDAR_KITTI, relative)
 
     def save_map(self) -> None:
         submap = farlio.Scan(self.odo.map_points())
@@ -249,6 +290,7 @@ class OdometryRun:
             "skipped": c.skipped,
             "dropped": c.dropped,
             "registered": c.registered,
+            "fused": c.fused,
             "degenerate": c.degenerate,
             "registration_failed": c.failed,
             "map_restarts": c.map_restarts,
@@ -287,7 +329,7 @@ class OdometryRun:
                 self.out_dir / SCANS_BODY_TUM, Path(gt_scans), self.out_dir / EVAL_SCANS_DIR, plot=plot
             )
         gt_dense = groundtruth or self.dataset.groundtruth()
-        if gt_dense is not None and (self.out_dir / ODOMETRY_TUM).exists():
+        if gt_dense is not None and self.odom_tum is not None and len(self.odom_tum) >= MIN_EVALUATED_POSES:
             summary["accuracy_odometry"] = evaluate_files(
                 self.out_dir / ODOMETRY_TUM, Path(gt_dense), self.out_dir / EVAL_ODOMETRY_DIR, plot=plot
             )

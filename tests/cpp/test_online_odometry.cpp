@@ -14,60 +14,22 @@
 #include "farlio/map/voxel_key.hpp"
 #include "farlio/pipeline/odometry.hpp"
 #include "farlio/pipeline/online_odometry.hpp"
-#include "farlio/sim/sequence_generator.hpp"
+#include "sim_recording.hpp"
 
 using namespace farlio;
 using namespace farlio::pipeline;
 
 namespace {
 
-struct Recording {
-  std::vector<Scan> scans;
-  std::vector<ImuSample> imu;
-  SE3 T_imu_lidar;
-  double gravity_m_s2 = 0;
-};
+using test::deterministic_config;
+using test::Recording;
 
 constexpr double kSeconds = 1.5;       // 15 scans: enough for the LIO to run, short under sanitizers
 constexpr std::size_t kKeepEvery = 4;  // every 4th point (~30k per scan) keeps sanitizer runs short
 
-/// Every k-th point of a scan with its time, intensity and sensor id.
-Scan thinned(const Scan& s, std::size_t k) {
-  Scan out;
-  out.start_stamp_ns = s.start_stamp_ns;
-  out.end_stamp_ns = s.end_stamp_ns;
-  for (std::size_t i = 0; i < s.size(); i += k) {
-    out.points.push_back(s.points[i]);
-    if (!s.time_s.empty()) out.time_s.push_back(s.time_s[i]);
-    if (!s.intensity.empty()) out.intensity.push_back(s.intensity[i]);
-    if (!s.sensor_id.empty()) out.sensor_id.push_back(s.sensor_id[i]);
-  }
-  return out;
-}
-
-Recording urban(double duration_s) {
-  sim::SimConfig cfg = sim::default_config(sim::Profile::Urban);
-  cfg.duration_s = duration_s;
-  const sim::SequenceGenerator gen(cfg);
-  Recording r;
-  for (std::size_t i = 0; i < gen.num_scans(); ++i) r.scans.push_back(thinned(gen.scan(i), kKeepEvery));
-  r.imu = gen.imu();
-  r.T_imu_lidar = gen.T_imu_lidar();
-  r.gravity_m_s2 = gen.gravity_m_s2();
-  return r;
-}
-
 const Recording& recording() {
-  static const Recording r = urban(kSeconds);
+  static const Recording r = test::record(sim::Profile::Urban, kSeconds, kKeepEvery);
   return r;
-}
-
-/// Results that do not depend on how fast this machine is: no registration time budget (a slow
-/// sanitizer build would otherwise drop frames the replay keeps, or the other way round).
-Config deterministic_config() {
-  Config c;
-  c.registration.time_budget_factor = std::numeric_limits<double>::infinity();
-  return c;
 }
 
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)

@@ -55,7 +55,9 @@ def test_a_bad_value_is_an_error_naming_the_field_and_leaves_the_config(name, va
 
 
 def test_rules_between_fields_are_checked_when_loading(tmp_path):
-    with pytest.raises(ValueError, match="preprocess.min_range_m must be below preprocess.max_range_m"):
+    with pytest.raises(
+        ValueError, match=r"preprocess.min_range_m \(300\) must be below preprocess.max_range_m \(200\)"
+    ):
         load_config(overrides=["preprocess.min_range_m=300"])
     f = tmp_path / "bad.yaml"
     f.write_text("fusion:\n  reference_filter_taps: 4\n")

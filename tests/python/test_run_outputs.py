@@ -25,6 +25,7 @@ SUMMARY_KEYS = [
     "skipped",
     "dropped",
     "registered",
+    "fused",
     "degenerate",
     "registration_failed",
     "map_restarts",

@@ -20,92 +20,122 @@ namespace farlio {
 inline constexpr int kMaxCovarianceNeighbors = 32;
 /// Voxels are indexed by int32 in the pool.
 inline constexpr double kMaxVoxelCapacity = 2147483647.0;
+// Upper bounds of the config fields (config_range.hpp): far beyond any sensor or platform, so that
+// only typos and unit mistakes are refused.
+/// Distances from the sensor (ranges, radii): 10 km, beyond any LiDAR.
+inline constexpr double kMaxDistance_m = 1e4;
+/// Voxel edges: 21-bit voxel keys hold +-2^20 voxels, +-10 km at the smallest voxel.
+inline constexpr double kMinVoxelSize_m = 0.01;
+inline constexpr double kMaxVoxelSize_m = 100.0;
+/// Points per voxel (the pool allocates this many slots per voxel).
+inline constexpr double kMaxPointsPerVoxel = 1000.0;
+/// Dimensionless ratios, factors and chi-square gates.
+inline constexpr double kMaxRatio = 1e6;
+/// Counts of iterations, samples, steps or taps.
+inline constexpr double kMaxCount = 1e6;
+/// Standard deviations, thresholds and rates in SI units (m, rad, m/s, rad/s, m/s^2).
+inline constexpr double kMaxSiValue = 1e3;
+/// Durations in s (the fusion keeps history_s / step_s states; stamps are int64 ns).
+inline constexpr double kMaxDuration_s = 60.0;
+/// Constant IMU biases: beyond these it is not a bias but a wrong unit or axis.
+inline constexpr double kMaxGyroBias_rad_s = 1.0;
+inline constexpr double kMaxAccelBias_m_s2 = 5.0;
+/// CPU threads of one pipeline.
+inline constexpr double kMaxThreads = 1024.0;
 
 // ---- preprocess: range crop of each incoming scan ----------------------------------------------
-#define FARLIO_PREPROCESS_FIELDS(FIELD)                                                               \
-  FIELD(double, min_range_m, 1.0, range::non_negative(),                                              \
-        "points closer than this to the sensor are dropped (the vehicle body)")                       \
-  FIELD(double, max_range_m, 200.0, range::positive_or_inf(), "points farther than this are dropped") \
+#define FARLIO_PREPROCESS_FIELDS(FIELD)                                           \
+  FIELD(double, min_range_m, 1.0, range::non_negative_up_to(kMaxDistance_m),      \
+        "points closer than this to the sensor are dropped (the vehicle body)")   \
+  FIELD(double, max_range_m, 200.0, range::positive_up_to_or_inf(kMaxDistance_m), \
+        "points farther than this are dropped")                                   \
   FIELD(bool, undistort, true, range::unchecked(), "motion undistortion (MU) of points with per-point times")
 
 // ---- map: the voxel hash map (the paper's cuVoxelMap), the adaptive local submap ----------------
-#define FARLIO_MAP_FIELDS(FIELD)                                                                                    \
-  FIELD(double, voxel_size_m, 4.0, range::positive(),                                                               \
-        "v: edge of a voxel cube (paper: 4 m); the upper bound when auto_voxel_size")                               \
-  FIELD(bool, auto_voxel_size, true, range::unchecked(),                                                            \
-        "scale the voxel to the scene at the first scan: v = clamp(p90 range / auto_range_ratio, "                  \
-        "auto_min_voxel_size_m, voxel_size_m); vehicles outdoors keep 4 m, rooms get a finer map")                  \
-  FIELD(double, auto_range_ratio, 6.0, range::positive(), "p90 range of the first scan over the voxel size (auto)") \
-  FIELD(double, auto_min_voxel_size_m, 1.0, range::positive(), "smallest voxel the auto scaling picks")             \
-  FIELD(int, max_points_per_voxel, 40, range::at_least(1), "N_max: points a voxel holds at most (paper: 40)")       \
-  FIELD(double, point_spacing_m, 0.0, range::non_negative(),                                                        \
-        "minimum distance between points of a voxel; 0: voxel_size_m / sqrt(N_max) (0.63 m at 4 m)")                \
-  FIELD(int, covariance_neighbors, 10, range::between(1, kMaxCovarianceNeighbors),                                  \
-        "k nearest neighbours of a point covariance (paper: 10)")                                                   \
-  FIELD(double, covariance_epsilon, 1e-3, range::positive(),                                                        \
-        "eps of the Frobenius regularisation: C = Sigma_hat + eps I, eq. (1)")                                      \
-  FIELD(double, line_eigenvalue_ratio, 10.0, range::non_negative(),                                                 \
-        "a covariance is line-like (a scan line, a pole) when, regularised, its middle eigenvalue is "              \
-        "below ratio x the smallest while the largest is above it; 0: never (all surfaces)")                        \
-  FIELD(double, removal_radius_m, 1000.0, range::positive_or_inf(),                                                 \
-        "voxels whose centre is farther than this from the pose are removed (inf: never)")                          \
-  FIELD(bool, refresh_covariances, true, range::unchecked(),                                                        \
-        "recompute the covariances of existing points in voxels that receive new points "                           \
-        "(the reference never refreshes them)")                                                                     \
-  FIELD(std::int64_t, initial_voxel_capacity, 1 << 14, range::between(1, kMaxVoxelCapacity),                        \
-        "voxels preallocated; the pool doubles as needed")                                                          \
-  FIELD(std::int64_t, max_voxel_capacity, 1 << 20, range::between(1, kMaxVoxelCapacity),                            \
+#define FARLIO_MAP_FIELDS(FIELD)                                                                       \
+  FIELD(double, voxel_size_m, 4.0, range::between(kMinVoxelSize_m, kMaxVoxelSize_m),                   \
+        "v: edge of a voxel cube (paper: 4 m); the upper bound when auto_voxel_size")                  \
+  FIELD(bool, auto_voxel_size, true, range::unchecked(),                                               \
+        "scale the voxel to the scene at the first scan: v = clamp(p90 range / auto_range_ratio, "     \
+        "auto_min_voxel_size_m, voxel_size_m); vehicles outdoors keep 4 m, rooms get a finer map")     \
+  FIELD(double, auto_range_ratio, 6.0, range::positive_up_to(kMaxRatio),                               \
+        "p90 range of the first scan over the voxel size (auto)")                                      \
+  FIELD(double, auto_min_voxel_size_m, 1.0, range::between(kMinVoxelSize_m, kMaxVoxelSize_m),          \
+        "smallest voxel the auto scaling picks")                                                       \
+  FIELD(int, max_points_per_voxel, 40, range::between(1, kMaxPointsPerVoxel),                          \
+        "N_max: points a voxel holds at most (paper: 40)")                                             \
+  FIELD(double, point_spacing_m, 0.0, range::non_negative_up_to(kMaxVoxelSize_m),                      \
+        "minimum distance between points of a voxel; 0: voxel_size_m / sqrt(N_max) (0.63 m at 4 m)")   \
+  FIELD(int, covariance_neighbors, 10, range::between(1, kMaxCovarianceNeighbors),                     \
+        "k nearest neighbours of a point covariance (paper: 10)")                                      \
+  FIELD(double, covariance_epsilon, 1e-3, range::positive_up_to(kMaxSiValue),                          \
+        "eps of the Frobenius regularisation: C = Sigma_hat + eps I, eq. (1)")                         \
+  FIELD(double, line_eigenvalue_ratio, 10.0, range::non_negative_up_to(kMaxRatio),                     \
+        "a covariance is line-like (a scan line, a pole) when, regularised, its middle eigenvalue is " \
+        "below ratio x the smallest while the largest is above it; 0: never (all surfaces)")           \
+  FIELD(double, removal_radius_m, 1000.0, range::positive_up_to_or_inf(kMaxDistance_m),                \
+        "voxels whose centre is farther than this from the pose are removed (inf: never)")             \
+  FIELD(bool, refresh_covariances, true, range::unchecked(),                                           \
+        "recompute the covariances of existing points in voxels that receive new points "              \
+        "(the reference never refreshes them)")                                                        \
+  FIELD(std::int64_t, initial_voxel_capacity, 1 << 14, range::between(1, kMaxVoxelCapacity),           \
+        "voxels preallocated; the pool doubles as needed")                                             \
+  FIELD(std::int64_t, max_voxel_capacity, 1 << 20, range::between(1, kMaxVoxelCapacity),               \
         "hard limit of the submap in voxels: growth beyond it is a CapacityError")
 
 // ---- density: adaptive submap density (ASMD), the per-voxel limit follows the scan's density ---
-#define FARLIO_DENSITY_FIELDS(FIELD)                                               \
-  FIELD(bool, enabled, true, range::unchecked(), "adaptive submap density (ASMD)") \
-  FIELD(double, close_range_m, 20.0, range::positive(),                            \
-        "the scan's density is averaged over frame-map voxels within this range")  \
-  FIELD(double, slope_points_per_m, 0.03, range::non_negative(),                   \
-        "linear decay of the per-voxel limit beyond close_range_m")                \
-  FIELD(int, frame_map_max_points_per_voxel, 20, range::at_least(1),               \
+#define FARLIO_DENSITY_FIELDS(FIELD)                                                     \
+  FIELD(bool, enabled, true, range::unchecked(), "adaptive submap density (ASMD)")       \
+  FIELD(double, close_range_m, 20.0, range::positive_up_to(kMaxDistance_m),              \
+        "the scan's density is averaged over frame-map voxels within this range")        \
+  FIELD(double, slope_points_per_m, 0.03, range::non_negative_up_to(kMaxPointsPerVoxel), \
+        "linear decay of the per-voxel limit beyond close_range_m")                      \
+  FIELD(int, frame_map_max_points_per_voxel, 20, range::between(1, kMaxPointsPerVoxel),  \
         "cap of the per-scan frame map that gives the source covariances (reference: 20)")
 
 // ---- threshold: KISS-ICP's adaptive correspondence threshold -----------------------------------
-#define FARLIO_THRESHOLD_FIELDS(FIELD)                                                                          \
-  FIELD(double, initial_threshold_m, 1.0, range::positive(), "sigma before any model deviation is observed")    \
-  FIELD(double, min_motion_m, 0.25, range::non_negative(), "model deviations below this are not sampled")       \
-  FIELD(double, max_range_m, 100.0, range::positive(), "range that turns a rotation error into a displacement") \
-  FIELD(double, max_threshold_m, 10.0, range::positive(), "sigma is capped here")
+#define FARLIO_THRESHOLD_FIELDS(FIELD)                                        \
+  FIELD(double, initial_threshold_m, 1.0, range::positive_up_to(kMaxSiValue), \
+        "sigma before any model deviation is observed")                       \
+  FIELD(double, min_motion_m, 0.25, range::non_negative_up_to(kMaxSiValue),   \
+        "model deviations below this are not sampled")                        \
+  FIELD(double, max_range_m, 100.0, range::positive_up_to(kMaxDistance_m),    \
+        "range that turns a rotation error into a displacement")              \
+  FIELD(double, max_threshold_m, 10.0, range::positive_up_to(kMaxSiValue), "sigma is capped here")
 
 // ---- registration: sparsity-aware GICP, scan to submap -----------------------------------------
-#define FARLIO_REGISTRATION_FIELDS(FIELD)                                                                           \
-  FIELD(bool, sparsity_aware, true, range::unchecked(),                                                             \
-        "GICP (true) or plain point-to-point ICP for every point (false)")                                          \
-  FIELD(double, point_to_point_sigma_m, 0.0, range::non_negative(),                                                 \
-        "residual std per axis of points without covariance (point-to-point factors); 0: half the map "             \
-        "spacing; the paper's Omega = I is sqrt(map.covariance_epsilon) = 0.0316 (docs/odometry.md)")               \
-  FIELD(bool, skip_line_pairs, true, range::unchecked(),                                                            \
-        "leave out correspondences whose two covariances are both line-like: two scan lines recorded "              \
-        "from the same place fake a constraint across the line")                                                    \
-  FIELD(int, max_iterations, 500, range::at_least(1), "Gauss-Newton iterations at most")                            \
-  FIELD(double, convergence_norm, 5e-3, range::positive(), "stop when |dx| (6-vector, m and rad) falls below this") \
-  FIELD(double, time_budget_factor, 2.0, range::positive_or_inf(),                                                  \
-        "time budget in LiDAR periods (paper: 2); a frame over it is dropped (inf: no budget)")                     \
-  FIELD(double, damping, 1e-9, range::non_negative(), "lambda added to the diagonal of H")                          \
-  FIELD(double, covariance_scale, 0.05, range::positive(),                                                          \
-        "pose covariance = covariance_scale * H^-1 (H in the factors' normalised units; docs/fusion.md measures "   \
-        "1e-3..2e-3 on consecutive scans and inflates it for errors shared through the map)")                       \
-  FIELD(double, degenerate_translation_std_m, 0.05, range::positive(),                                              \
-        "a body-frame direction whose translation std (from covariance_scale * H^-1) exceeds this is degenerate")   \
-  FIELD(double, degenerate_rotation_std_rad, 0.01, range::positive(),                                               \
-        "a body-frame axis whose rotation std exceeds this is degenerate")                                          \
-  FIELD(bool, hold_degenerate_directions, true, range::unchecked(),                                                 \
-        "LIO: Gauss-Newton does not move the pose along degenerate directions (they stay at the IMU prediction) "   \
-        "and the fusion takes them from the IMU; false, or LiDAR-only: the scan's weak constraint is used")         \
-  FIELD(int, min_inliers, 100, range::at_least(1),                                                                  \
-        "a registration with fewer correspondences has failed: the scan keeps the predicted pose and updates "      \
-        "neither the map, the adaptive threshold nor the fusion")                                                   \
-  FIELD(double, min_inlier_fraction, 0.5, range::fraction(),                                                        \
-        "a registration matching fewer of the source points has failed (a scan of something else: a bogus "         \
-        "scan, a sensor fault)")                                                                                    \
-  FIELD(double, map_restart_after_s, 1.0, range::positive_or_inf(),                                                 \
+#define FARLIO_REGISTRATION_FIELDS(FIELD)                                                                         \
+  FIELD(bool, sparsity_aware, true, range::unchecked(),                                                           \
+        "GICP (true) or plain point-to-point ICP for every point (false)")                                        \
+  FIELD(double, point_to_point_sigma_m, 0.0, range::non_negative_up_to(kMaxSiValue),                              \
+        "residual std per axis of points without covariance (point-to-point factors); 0: half the map "           \
+        "spacing; the paper's Omega = I is sqrt(map.covariance_epsilon) = 0.0316 (docs/odometry.md)")             \
+  FIELD(bool, skip_line_pairs, true, range::unchecked(),                                                          \
+        "leave out correspondences whose two covariances are both line-like: two scan lines recorded "            \
+        "from the same place fake a constraint across the line")                                                  \
+  FIELD(int, max_iterations, 500, range::between(1, kMaxCount), "Gauss-Newton iterations at most")                \
+  FIELD(double, convergence_norm, 5e-3, range::positive_up_to(kMaxSiValue),                                       \
+        "stop when |dx| (6-vector, m and rad) falls below this")                                                  \
+  FIELD(double, time_budget_factor, 2.0, range::positive_up_to_or_inf(kMaxRatio),                                 \
+        "time budget in LiDAR periods (paper: 2); a frame over it is dropped (inf: no budget)")                   \
+  FIELD(double, damping, 1e-9, range::non_negative_up_to(kMaxRatio), "lambda added to the diagonal of H")         \
+  FIELD(double, covariance_scale, 0.05, range::positive_up_to(kMaxRatio),                                         \
+        "pose covariance = covariance_scale * H^-1 (H in the factors' normalised units; docs/fusion.md measures " \
+        "1e-3..2e-3 on consecutive scans and inflates it for errors shared through the map)")                     \
+  FIELD(double, degenerate_translation_std_m, 0.05, range::positive_up_to(kMaxSiValue),                           \
+        "a body-frame direction whose translation std (from covariance_scale * H^-1) exceeds this is degenerate") \
+  FIELD(double, degenerate_rotation_std_rad, 0.01, range::positive_up_to(kMaxSiValue),                            \
+        "a body-frame axis whose rotation std exceeds this is degenerate")                                        \
+  FIELD(bool, hold_degenerate_directions, true, range::unchecked(),                                               \
+        "LIO: Gauss-Newton does not move the pose along degenerate directions (they stay at the IMU prediction) " \
+        "and the fusion takes them from the IMU; false, or LiDAR-only: the scan's weak constraint is used")       \
+  FIELD(int, min_inliers, 100, range::between(1, kMaxCount),                                                      \
+        "a registration with fewer correspondences has failed: the scan keeps the predicted pose and updates "    \
+        "neither the map, the adaptive threshold nor the fusion")                                                 \
+  FIELD(double, min_inlier_fraction, 0.5, range::fraction(),                                                      \
+        "a registration matching fewer of the source points has failed (a scan of something else: a bogus "       \
+        "scan, a sensor fault)")                                                                                  \
+  FIELD(double, map_restart_after_s, 1.0, range::positive_up_to_or_inf(kMaxSiValue),                              \
         "after failed registrations for this long, the map restarts from the current scan at the prediction")
 
 // ---- fusion: the kinematic EKF (paper eqs. 7-10) fusing IMU inputs with LiDAR poses -------------
@@ -113,92 +143,120 @@ inline constexpr double kMaxVoxelCapacity = 2147483647.0;
 #define FARLIO_FUSION_FIELDS(FIELD)                                                                                   \
   FIELD(bool, enabled, true, range::unchecked(), "fuse the IMU (LIO); false or no IMU: LiDAR-only odometry")          \
   FIELD(double, step_s, 0.01, range::between(1e-4, 1.0), "fixed EKF step and odometry output period (paper: 100 Hz)") \
-  FIELD(double, history_s, 1.0, range::positive(), "state history kept for delay compensation and pose queries")      \
-  FIELD(double, max_extrapolation_s, 0.1, range::non_negative(),                                                      \
+  FIELD(double, history_s, 1.0, range::positive_up_to(kMaxDuration_s),                                                \
+        "state history kept for delay compensation and pose queries")                                                 \
+  FIELD(double, max_extrapolation_s, 0.1, range::non_negative_up_to(kMaxDuration_s),                                  \
         "a pose may be predicted this far beyond the newest step")                                                    \
-  FIELD(double, imu_gap_limit_s, 0.1, range::positive(),                                                              \
+  FIELD(double, imu_gap_limit_s, 0.1, range::positive_up_to(kMaxDuration_s),                                          \
         "IMU samples farther apart are a gap: the last input is held")                                                \
-  FIELD(double, gyro_input_std_rad_s, 0.02, range::positive(),                                                        \
+  FIELD(double, max_bridged_gap_s, 1.0, range::positive_up_to(kMaxDuration_s),                                        \
+        "largest jump of the IMU clock the fusion takes: a gap up to this is predicted across, a sample up to this "  \
+        "older than the newest is dropped; a larger jump either way resets the fusion with a warning (it starts "     \
+        "again from the next LiDAR result), and a LiDAR result older than the IMU clock by more does not "            \
+        "initialise the filter")                                                                                      \
+  FIELD(double, gyro_input_std_rad_s, 0.02, range::positive_up_to(kMaxSiValue),                                       \
         "std of the gyro input averaged over one step, process noise B Q B^T "                                        \
         "(reference: variances 3e-4..3e-3 rad^2/s^2 at 100 Hz)")                                                      \
-  FIELD(double, accel_input_std_m_s2, 1.0, range::positive(),                                                         \
+  FIELD(double, accel_input_std_m_s2, 1.0, range::positive_up_to(kMaxSiValue),                                        \
         "std of the accelerometer input averaged over one step, process noise B Q B^T "                               \
         "(reference: variances 1..4 m^2/s^4 at 100 Hz)")                                                              \
-  FIELD(double, initial_position_std_m, 0.1, range::positive(),                                                       \
+  FIELD(double, initial_position_std_m, 0.1, range::positive_up_to(kMaxSiValue),                                      \
         "position std at initialisation (the first LiDAR pose)")                                                      \
-  FIELD(double, initial_attitude_std_rad, 0.02, range::positive(), "roll/pitch/yaw std at initialisation")            \
-  FIELD(double, initial_velocity_std_m_s, 20.0, range::positive(),                                                    \
+  FIELD(double, initial_attitude_std_rad, 0.02, range::positive_up_to(kMaxSiValue),                                   \
+        "roll/pitch/yaw std at initialisation")                                                                       \
+  FIELD(double, initial_velocity_std_m_s, 20.0, range::positive_up_to(kMaxSiValue),                                   \
         "velocity std at initialisation when the first LiDAR result carries no velocity")                             \
-  FIELD(double, lidar_position_std_m, 0.05, range::positive(), "LiDAR position measurement std per axis")             \
-  FIELD(double, lidar_roll_pitch_std_rad, 0.02, range::positive(), "LiDAR roll and pitch measurement std")            \
-  FIELD(double, lidar_yaw_std_rad, 0.01, range::positive(), "LiDAR yaw measurement std")                              \
-  FIELD(double, lidar_velocity_std_m_s, 0.8, range::positive(),                                                       \
+  FIELD(double, lidar_position_std_m, 0.05, range::positive_up_to(kMaxSiValue),                                       \
+        "LiDAR position measurement std per axis")                                                                    \
+  FIELD(double, lidar_roll_pitch_std_rad, 0.02, range::positive_up_to(kMaxSiValue),                                   \
+        "LiDAR roll and pitch measurement std")                                                                       \
+  FIELD(double, lidar_yaw_std_rad, 0.01, range::positive_up_to(kMaxSiValue), "LiDAR yaw measurement std")             \
+  FIELD(double, lidar_velocity_std_m_s, 0.8, range::positive_up_to(kMaxSiValue),                                      \
         "LiDAR body velocity (eq. 6) measurement std per axis")                                                       \
   FIELD(bool, lidar_information_from_registration, true, range::unchecked(),                                          \
         "the LiDAR pose is fused with its registration's covariance (registration.covariance_scale * H^-1, "          \
         "tight where the scene constrains it, loose where degenerate) instead of the fixed lidar_*_std")              \
-  FIELD(double, lidar_min_position_std_m, 0.002, range::positive(),                                                   \
+  FIELD(double, lidar_min_position_std_m, 0.002, range::positive_up_to(kMaxSiValue),                                  \
         "floor of the registration's position std per axis")                                                          \
-  FIELD(double, lidar_min_attitude_std_rad, 2e-4, range::positive(), "floor of the registration's attitude std")      \
+  FIELD(double, lidar_min_attitude_std_rad, 2e-4, range::positive_up_to(kMaxSiValue),                                 \
+        "floor of the registration's attitude std")                                                                   \
   FIELD(bool, estimate_imu_bias, true, range::unchecked(),                                                            \
         "gyro and accelerometer biases as filter states (false: the paper's 9-state filter)")                         \
-  FIELD(double, gyro_bias_std_rad_s, 0.01, range::positive(), "initial std of the gyro bias state")                   \
-  FIELD(double, accel_bias_std_m_s2, 0.1, range::positive(), "initial std of the accelerometer bias state")           \
-  FIELD(double, gyro_bias_walk_rad_s2_sqrt_hz, 2e-4, range::non_negative(), "gyro bias random walk density")          \
-  FIELD(double, accel_bias_walk_m_s3_sqrt_hz, 2e-3, range::non_negative(), "accelerometer bias random walk density")  \
-  FIELD(double, imu_max_accel_m_s2, 160.0, range::positive(),                                                         \
+  FIELD(double, gyro_bias_std_rad_s, 0.01, range::positive_up_to(kMaxSiValue), "initial std of the gyro bias state")  \
+  FIELD(double, accel_bias_std_m_s2, 0.1, range::positive_up_to(kMaxSiValue),                                         \
+        "initial std of the accelerometer bias state")                                                                \
+  FIELD(double, gyro_bias_walk_rad_s2_sqrt_hz, 2e-4, range::non_negative_up_to(kMaxSiValue),                          \
+        "gyro bias random walk density")                                                                              \
+  FIELD(double, accel_bias_walk_m_s3_sqrt_hz, 2e-3, range::non_negative_up_to(kMaxSiValue),                           \
+        "accelerometer bias random walk density")                                                                     \
+  FIELD(double, imu_max_accel_m_s2, 160.0, range::positive_up_to(kMaxSiValue),                                       \
         "an IMU sample with |accel| over this is impossible and rejected (16 g: MEMS full scale)")                    \
-  FIELD(double, imu_max_gyro_rad_s, 35.0, range::positive(),                                                          \
+  FIELD(double, imu_max_gyro_rad_s, 35.0, range::positive_up_to(kMaxSiValue),                                         \
         "an IMU sample with |gyro| over this is impossible and rejected (2000 deg/s: MEMS full scale)")               \
-  FIELD(double, imu_spike_accel_m_s2, 50.0, range::positive(),                                                        \
+  FIELD(double, imu_spike_accel_m_s2, 50.0, range::positive_up_to(kMaxSiValue),                                       \
         "an accelerometer axis this far from the median of the recent samples is a spike: rejected")                  \
-  FIELD(double, imu_spike_gyro_rad_s, 10.0, range::positive(),                                                        \
+  FIELD(double, imu_spike_gyro_rad_s, 10.0, range::positive_up_to(kMaxSiValue),                                       \
         "a gyro axis this far from the median of the recent samples is a spike: rejected")                            \
-  FIELD(int, imu_spike_window_samples, 9, range::non_negative(),                                                      \
+  FIELD(int, imu_spike_window_samples, 9, range::between(0, kMaxCount),                                               \
         "samples in the spike median (0: no spike test); a real step passes after half of them")                      \
   FIELD(bool, outlier_rejection, true, range::unchecked(), "Mahalanobis outlier rejection per measurement group")     \
-  FIELD(double, outlier_chi2_3dof, 16.27, range::positive(), "chi-square gate of 3-dof groups (99.9 % quantile)")     \
-  FIELD(double, outlier_chi2_2dof, 13.82, range::positive(), "chi-square gate of 2-dof groups (99.9 % quantile)")     \
-  FIELD(double, outlier_chi2_6dof, 22.46, range::positive(), "chi-square gate of 6-dof groups (99.9 % quantile)")     \
-  FIELD(int, max_consecutive_rejections, 10, range::at_least(1),                                                      \
+  FIELD(double, outlier_chi2_3dof, 16.27, range::positive_up_to(kMaxRatio),                                           \
+        "chi-square gate of 3-dof groups (99.9 % quantile)")                                                          \
+  FIELD(double, outlier_chi2_2dof, 13.82, range::positive_up_to(kMaxRatio),                                           \
+        "chi-square gate of 2-dof groups (99.9 % quantile)")                                                          \
+  FIELD(double, outlier_chi2_6dof, 22.46, range::positive_up_to(kMaxRatio),                                           \
+        "chi-square gate of 6-dof groups (99.9 % quantile)")                                                          \
+  FIELD(int, max_consecutive_rejections, 10, range::between(1, kMaxCount),                                            \
         "LiDAR positions rejected in a row before the filter re-initialises from the LiDAR pose")                     \
   FIELD(bool, reference_angles, true, range::unchecked(),                                                             \
         "fuse roll/pitch reference angles, a pseudo-measurement from gravity in the body frame")                      \
-  FIELD(double, reference_roll_std_rad, 0.22, range::positive(),                                                      \
+  FIELD(double, reference_roll_std_rad, 0.22, range::positive_up_to(kMaxSiValue),                                     \
         "reference roll std (reference: variance 0.05 rad^2)")                                                        \
-  FIELD(double, reference_pitch_std_rad, 0.32, range::positive(),                                                     \
+  FIELD(double, reference_pitch_std_rad, 0.32, range::positive_up_to(kMaxSiValue),                                    \
         "reference pitch std (reference: variance 0.1 rad^2)")                                                        \
-  FIELD(int, reference_filter_taps, 11, range::at_least(1),                                                           \
+  FIELD(int, reference_filter_taps, 11, range::between(1, kMaxCount),                                                 \
         "taps of the Hann low-pass of the reference angle terms (odd)")                                               \
   FIELD(double, reference_max_sin, 0.5, range::fraction(),                                                            \
         "clamp of the asin argument (30 deg); clamped reference angles are not fused")                                \
   FIELD(bool, delay_compensation, true, range::unchecked(), "shift delayed measurements by eq. (10)")                 \
-  FIELD(int, update_spread_steps, 0, range::non_negative(),                                                           \
+  FIELD(int, update_spread_steps, 0, range::non_negative_up_to(kMaxCount),                                            \
         "N: a LiDAR result is injected over N steps with N R each; 0: the LiDAR period / step_s")                     \
-  FIELD(int, max_update_spread_steps, 20, range::at_least(1), "cap of the automatic N")                               \
+  FIELD(int, max_update_spread_steps, 20, range::between(1, kMaxCount), "cap of the automatic N")                     \
   FIELD(bool, standstill_bias, true, range::unchecked(),                                                              \
         "learn the gyro bias at standstill (the accelerometer bias stays at its initial value, as in the paper)")     \
-  FIELD(double, standstill_max_speed_m_s, 0.4, range::non_negative(), "standstill: estimated speed below this")       \
-  FIELD(double, standstill_max_gyro_rad_s, 0.05, range::non_negative(), "standstill: |gyro| below this")              \
-  FIELD(double, standstill_max_accel_deviation_m_s2, 1.0, range::non_negative(),                                      \
+  FIELD(double, standstill_max_speed_m_s, 0.4, range::non_negative_up_to(kMaxSiValue),                                \
+        "standstill: estimated speed below this")                                                                     \
+  FIELD(double, standstill_max_gyro_rad_s, 0.05, range::non_negative_up_to(kMaxSiValue),                              \
+        "standstill: |gyro| below this")                                                                              \
+  FIELD(double, standstill_max_accel_deviation_m_s2, 1.0, range::non_negative_up_to(kMaxSiValue),                     \
         "standstill: | |accel| - g | below this")                                                                     \
-  FIELD(int, bias_window_samples, 10000, range::at_least(1), "gyro bias running mean over at most this many samples") \
-  FIELD(int, bias_prior_samples, 100, range::non_negative(),                                                          \
+  FIELD(int, bias_window_samples, 10000, range::between(1, kMaxCount),                                                \
+        "gyro bias running mean over at most this many samples")                                                      \
+  FIELD(int, bias_prior_samples, 100, range::non_negative_up_to(kMaxCount),                                           \
         "weight of the initial gyro bias in the mean, in samples")                                                    \
-  FIELD(double, gyro_bias_init_x_rad_s, 0.0, range::finite(), "initial gyro bias x")                                  \
-  FIELD(double, gyro_bias_init_y_rad_s, 0.0, range::finite(), "initial gyro bias y")                                  \
-  FIELD(double, gyro_bias_init_z_rad_s, 0.0, range::finite(), "initial gyro bias z")                                  \
-  FIELD(double, accel_bias_x_m_s2, 0.0, range::finite(), "accelerometer bias x (not estimated, as in the paper)")     \
-  FIELD(double, accel_bias_y_m_s2, 0.0, range::finite(), "accelerometer bias y (not estimated, as in the paper)")     \
-  FIELD(double, accel_bias_z_m_s2, 0.0, range::finite(), "accelerometer bias z (not estimated, as in the paper)")     \
+  FIELD(double, gyro_bias_init_x_rad_s, 0.0, range::symmetric(kMaxGyroBias_rad_s), "initial gyro bias x")             \
+  FIELD(double, gyro_bias_init_y_rad_s, 0.0, range::symmetric(kMaxGyroBias_rad_s), "initial gyro bias y")             \
+  FIELD(double, gyro_bias_init_z_rad_s, 0.0, range::symmetric(kMaxGyroBias_rad_s), "initial gyro bias z")             \
+  FIELD(double, accel_bias_x_m_s2, 0.0, range::symmetric(kMaxAccelBias_m_s2),                                         \
+        "accelerometer bias x (not estimated, as in the paper)")                                                      \
+  FIELD(double, accel_bias_y_m_s2, 0.0, range::symmetric(kMaxAccelBias_m_s2),                                         \
+        "accelerometer bias y (not estimated, as in the paper)")                                                      \
+  FIELD(double, accel_bias_z_m_s2, 0.0, range::symmetric(kMaxAccelBias_m_s2),                                         \
+        "accelerometer bias z (not estimated, as in the paper)")                                                      \
   FIELD(bool, accel_unit_detection, true, range::unchecked(), "detect an accelerometer reporting in g and scale it")  \
-  FIELD(int, accel_unit_detection_samples, 50, range::at_least(1),                                                    \
-        "the mean |accel| of these first samples decides the unit")
+  FIELD(int, accel_unit_detection_samples, 50, range::between(1, kMaxCount),                                          \
+        "the mean |accel| of these first samples decides the unit")                                                   \
+  FIELD(bool, gyro_unit_detection, true, range::unchecked(),                                                          \
+        "detect a gyro reporting in deg/s (its rotation ~57x the LiDAR's) and scale it; a gyro that stays "           \
+        "constant while the LiDAR turns is not used")                                                                 \
+  FIELD(double, gyro_unit_min_rotation_rad, 0.3, range::positive_up_to(kMaxSiValue),                                  \
+        "the gyro unit is decided once the gyro's or the LiDAR's rotation over the scans reaches this; until then "   \
+        "a scan during which the gyro turns is registered without the fusion's guess")
 
 // ---- cuda: the CUDA backend's device buffers, allocated once when the pipeline starts ----------
 // A scan or map beyond them raises CapacityError naming the field to raise (docs/cuda.md).
 #define FARLIO_CUDA_FIELDS(FIELD)                                                      \
-  FIELD(std::int64_t, max_scan_points, 1 << 19, range::at_least(1),                    \
+  FIELD(std::int64_t, max_scan_points, 1 << 19, range::between(1, kMaxVoxelCapacity),  \
         "device buffers: points of one scan, all LiDARs merged (racetrack: ~210k)")    \
   FIELD(std::int64_t, max_map_voxels, 1 << 18, range::between(1, kMaxVoxelCapacity),   \
         "device buffers: submap voxels (N_max points each)")                           \
@@ -209,7 +267,7 @@ inline constexpr double kMaxVoxelCapacity = 2147483647.0;
 #define FARLIO_TOP_FIELDS(FIELD)                                                           \
   FIELD(Device, device, Device::Auto, range::unchecked(),                                  \
         "scan pipeline backend: auto (CUDA when a GPU is present, else CPU), cpu or cuda") \
-  FIELD(int, num_threads, 0, range::non_negative(), "CPU threads of this pipeline instance (0: all)")
+  FIELD(int, num_threads, 0, range::non_negative_up_to(kMaxThreads), "CPU threads of this pipeline instance (0: all)")
 
 #define FARLIO_CONFIG_MEMBER(type, name, default_value, valid, doc) type name = default_value;
 

@@ -196,21 +196,31 @@ std::string get_config_field(const Config& config, const std::string& name) {
 void validate_config(const VoxelMapConfig& map, const std::string& prefix) {
   check_ranges(map, prefix);
   require(!map.auto_voxel_size || map.auto_min_voxel_size_m <= map.voxel_size_m,
-          prefix + ".auto_min_voxel_size_m must not exceed " + prefix + ".voxel_size_m (the largest auto voxel)");
+          prefix + ".auto_min_voxel_size_m (" + number_text(map.auto_min_voxel_size_m) + ") must not exceed " + prefix +
+              ".voxel_size_m (" + number_text(map.voxel_size_m) + ", the largest auto voxel)");
   require(map.initial_voxel_capacity <= map.max_voxel_capacity,
-          prefix + ".initial_voxel_capacity must not exceed " + prefix + ".max_voxel_capacity");
+          prefix + ".initial_voxel_capacity (" + number_text(map.initial_voxel_capacity) + ") must not exceed " +
+              prefix + ".max_voxel_capacity (" + number_text(map.max_voxel_capacity) + ")");
 }
 
 void validate_config(const FusionConfig& fusion) {
   check_ranges(fusion, "fusion");
-  require(fusion.reference_filter_taps % 2 == 1, "fusion.reference_filter_taps must be odd");
-  require(fusion.history_s >= fusion.step_s, "fusion.history_s must hold at least one fusion.step_s");
+  require(fusion.reference_filter_taps % 2 == 1,
+          "fusion.reference_filter_taps must be odd, got " + number_text(fusion.reference_filter_taps));
+  require(fusion.history_s >= fusion.step_s, "fusion.history_s (" + number_text(fusion.history_s) +
+                                                 ") must hold at least one fusion.step_s (" +
+                                                 number_text(fusion.step_s) + ")");
+  require(fusion.imu_gap_limit_s <= fusion.max_bridged_gap_s,
+          "fusion.imu_gap_limit_s (" + number_text(fusion.imu_gap_limit_s) +
+              ") must not exceed fusion.max_bridged_gap_s (" + number_text(fusion.max_bridged_gap_s) +
+              "): a gap the fusion holds its input across must be bridged");
 }
 
 void validate_config(const Config& config) {
   check_ranges(config.preprocess, "preprocess");
   require(config.preprocess.min_range_m < config.preprocess.max_range_m,
-          "preprocess.min_range_m must be below preprocess.max_range_m");
+          "preprocess.min_range_m (" + number_text(config.preprocess.min_range_m) +
+              ") must be below preprocess.max_range_m (" + number_text(config.preprocess.max_range_m) + ")");
   validate_config(config.map);
   check_ranges(config.density, "density");
   check_ranges(config.threshold, "threshold");
@@ -221,6 +231,14 @@ void validate_config(const Config& config) {
   std::vector<ConfigField> top;
   append_fields(top, copy, "");
   for (const ConfigField& f : top) check_range(f);
+}
+
+void validate_gravity(double gravity_m_s2, const std::string& source) {
+  if (gravity_m_s2 >= kMinGravity_m_s2 && gravity_m_s2 <= kMaxGravity_m_s2) return;  // false for NaN
+  throw std::invalid_argument(source + ": must be the magnitude of gravity in m/s^2, about 9.8 (in [" +
+                              number_text(kMinGravity_m_s2) + ", " + number_text(kMaxGravity_m_s2) + "]), got " +
+                              number_text(gravity_m_s2) +
+                              (gravity_m_s2 < 0.0 ? " (no sign: the direction comes from the accelerometer)" : ""));
 }
 
 }  // namespace farlio

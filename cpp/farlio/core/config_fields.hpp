@@ -43,6 +43,14 @@ void validate_config(const Config& config);
 void validate_config(const VoxelMapConfig& map, const std::string& prefix = "map");
 void validate_config(const FusionConfig& fusion);
 
+/// Gravity is a magnitude in m/s^2 close to Earth's (9.78 at the equator, 9.83 at the poles): a sign,
+/// 0, or 1 (gravity in g) is a mistake.
+inline constexpr double kMinGravity_m_s2 = 9.5;
+inline constexpr double kMaxGravity_m_s2 = 10.2;
+/// Throws std::invalid_argument naming `source` (where the value came from) when gravity_m_s2 is
+/// not a magnitude in [kMinGravity_m_s2, kMaxGravity_m_s2].
+void validate_gravity(double gravity_m_s2, const std::string& source);
+
 /// `config` (a Config or a section above) after validate_config, for member initialisers.
 template <typename C>
 const C& validated(const C& config) {

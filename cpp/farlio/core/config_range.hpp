@@ -21,17 +21,21 @@ struct FieldRange {
 
 namespace range {
 inline constexpr double kInf = std::numeric_limits<double>::infinity();
+// Every numeric field has a finite upper bound (or allows inf explicitly as "no limit"): a value
+// beyond what any sensor or computer needs is a typo, and some would overflow a conversion (s to
+// ns) or an allocation (history entries, filter taps).
 /// bool and enum fields.
 constexpr FieldRange unchecked() { return {-kInf, kInf, false, false, false}; }
-/// Any finite number.
-constexpr FieldRange finite() { return {-kInf, kInf, false, false, true}; }
-constexpr FieldRange positive() { return {0.0, kInf, true, false, true}; }
-/// Positive, or inf for "no limit".
-constexpr FieldRange positive_or_inf() { return {0.0, kInf, true, true, true}; }
-constexpr FieldRange non_negative() { return {0.0, kInf, false, false, true}; }
-constexpr FieldRange at_least(double lo) { return {lo, kInf, false, false, true}; }
 /// lo <= v <= hi.
 constexpr FieldRange between(double lo, double hi) { return {lo, hi, false, false, true}; }
+/// 0 < v <= hi.
+constexpr FieldRange positive_up_to(double hi) { return {0.0, hi, true, false, true}; }
+/// 0 < v <= hi, or inf for "no limit".
+constexpr FieldRange positive_up_to_or_inf(double hi) { return {0.0, hi, true, true, true}; }
+/// 0 <= v <= hi.
+constexpr FieldRange non_negative_up_to(double hi) { return {0.0, hi, false, false, true}; }
+/// -limit <= v <= limit.
+constexpr FieldRange symmetric(double limit) { return {-limit, limit, false, false, true}; }
 /// 0 < v <= 1.
 constexpr FieldRange fraction() { return {0.0, 1.0, true, false, true}; }
 }  // namespace range

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "farlio/core/config_fields.hpp"
 #include "farlio/core/error.hpp"
 #include "farlio/io/file_bytes.hpp"
 #include "farlio/io/rigid_transform.hpp"
@@ -24,6 +25,22 @@ double scalar_value(const YAML::Node& node, const std::string& file, const std::
   } catch (const YAML::Exception&) {
     throw InputError(file + ": key '" + key + "' is not a number");
   }
+}
+
+/// `gravity`: its magnitude in m/s^2 (validate_gravity), not a vector.
+double gravity_value(const YAML::Node& node, const std::string& file) {
+  const std::string what = file + ": key 'gravity'";
+  if (!node.IsScalar()) {
+    throw InputError(what + ": expected the magnitude of gravity in m/s^2 (one number, about 9.8), got a " +
+                     (node.IsSequence() ? "list" : "mapping") + "; the direction comes from the accelerometer");
+  }
+  const double g = scalar_value(node, file, "gravity");
+  try {
+    validate_gravity(g, what);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(e.what());
+  }
+  return g;
 }
 
 /// A rigid transform written as a 4x4 row-major nested list under `key`.
@@ -142,7 +159,7 @@ Calibration parse_calibration(const std::string& text, const std::filesystem::pa
   } else {
     c.T_imu_lidar = extrinsic_value(extrinsic, file, kExtrinsicKey);
   }
-  if (root["gravity"]) c.gravity_m_s2 = scalar_value(root["gravity"], file, "gravity");
+  if (root["gravity"]) c.gravity_m_s2 = gravity_value(root["gravity"], file);
   c.imu_rate_hz = optional_rate(root, "imu", file);
   c.lidar_rate_hz = optional_rate(root, "lidar", file);
   return c;

@@ -35,6 +35,20 @@ std::string tum_line(std::int64_t stamp_ns, const SE3& pose) {
   return s;
 }
 
+/// The 3x4 row-major [R | t] of a KITTI line.
+std::string kitti_line(const SE3& pose) {
+  const Mat4d m = pose.matrix();
+  std::string s;
+  for (int r = 0; r < kKittiRows; ++r) {
+    for (int c = 0; c < kKittiCols; ++c) {
+      if (r || c) s += ' ';
+      s += format_number(m(r, c));
+    }
+  }
+  s += '\n';
+  return s;
+}
+
 std::ifstream open_for_reading(const std::filesystem::path& path) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path.string() + ": no such file");
@@ -208,26 +222,21 @@ Trajectory read_trajectory(const std::filesystem::path& path, TrajectoryFormat f
 
 void write_kitti(const std::filesystem::path& path, const Trajectory& trajectory) {
   std::string text;
-  for (const auto& p : trajectory) {
-    const Mat4d m = p.pose.matrix();
-    for (int r = 0; r < kKittiRows; ++r) {
-      for (int c = 0; c < kKittiCols; ++c) {
-        if (r || c) text += ' ';
-        text += format_number(m(r, c));
-      }
-    }
-    text += '\n';
-  }
+  for (const auto& p : trajectory) text += kitti_line(p.pose);
   write_text_file(path, text);
 }
 
-TrajectoryWriter::TrajectoryWriter(const std::filesystem::path& path) : out_(path) {
-  out_.write(kTumHeader);
-  out_.flush();
+TrajectoryWriter::TrajectoryWriter(const std::filesystem::path& path, TrajectoryFormat format)
+    : out_(path), kitti_(format == TrajectoryFormat::kKitti) {
+  if (format == TrajectoryFormat::kAuto) throw std::invalid_argument(path.string() + ": write TUM or KITTI, not auto");
+  if (!kitti_) {
+    out_.write(kTumHeader);
+    out_.flush();
+  }
 }
 
 void TrajectoryWriter::append(std::int64_t stamp_ns, const SE3& pose) {
-  out_.write(tum_line(stamp_ns, pose));
+  out_.write(kitti_ ? kitti_line(pose) : tum_line(stamp_ns, pose));
   out_.flush();
   ++count_;
 }

@@ -73,18 +73,20 @@ inline constexpr std::array<std::pair<std::string_view, TrajectoryFormat>, 3> kT
                                          const std::optional<std::filesystem::path>& kitti_times = std::nullopt,
                                          Warnings* warnings = nullptr);
 
-/// Writes a TUM file pose by pose, flushing each line, so a crash loses nothing written. A
-/// failed write throws std::runtime_error naming the file and the reason.
+/// Writes a TUM file (or a KITTI file: the poses only) pose by pose, flushing each line, so a
+/// crash loses nothing written. A failed write throws std::runtime_error naming the file and the
+/// reason.
 class TrajectoryWriter {
  public:
-  /// Creates (truncates) the file and writes a comment header.
-  explicit TrajectoryWriter(const std::filesystem::path& path);
+  /// Creates (truncates) the file and writes a comment header (TUM only); `format` kTum or kKitti.
+  explicit TrajectoryWriter(const std::filesystem::path& path, TrajectoryFormat format = TrajectoryFormat::kTum);
   void append(std::int64_t stamp_ns, const SE3& pose);
   [[nodiscard]] std::size_t size() const { return count_; }
   [[nodiscard]] const std::filesystem::path& path() const { return out_.path(); }
 
  private:
   OutputFile out_;
+  bool kitti_;
   std::size_t count_ = 0;
 };
 

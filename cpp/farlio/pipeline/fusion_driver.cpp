@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 
+#include "farlio/core/config_fields.hpp"
 #include "farlio/core/time.hpp"
 #include "farlio/deskew/motion_fit.hpp"
 #include "farlio/fusion/lidar_measurement.hpp"
@@ -12,6 +15,14 @@ namespace {
 
 // Poses sampled over a scan for the motion regression.
 constexpr int kMotionSamples = 11;
+/// Warnings kept between two take_warnings calls; later ones are counted, not kept.
+constexpr std::size_t kMaxPendingWarnings = 100;
+
+std::string seconds_text(double s) {
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "%.3f", s);
+  return buf;
+}
 
 std::optional<deskew::ScanMotion> motion_from_fusion(const fusion::SensorFusion& fusion, const Scan& scan,
                                                      const SE3& end_pose, const SE3& T_imu_lidar) {
@@ -60,33 +71,130 @@ std::string drop_reason(const FrameResult& result, bool map_started) {
 }
 
 FusionDriver::FusionDriver(const Config& config, double gravity_m_s2, const SE3& T_imu_lidar, bool inertial)
-    : registration_config_(config.registration), T_imu_lidar_(T_imu_lidar) {
-  if (inertial) fusion_.emplace(config.fusion, gravity_m_s2);
+    : registration_config_(validated(config).registration),
+      fusion_config_(config.fusion),
+      gravity_m_s2_(gravity_m_s2),
+      max_bridged_gap_ns_(seconds_to_ns(config.fusion.max_bridged_gap_s)),
+      T_imu_lidar_(T_imu_lidar),
+      gyro_unit_(config.fusion.gyro_unit_detection, config.fusion.gyro_unit_min_rotation_rad,
+                 config.fusion.standstill_max_gyro_rad_s) {
+  validate_gravity(gravity_m_s2, "gravity_m_s2");
+  if (inertial) fusion_.emplace(fusion_config_, gravity_m_s2_);
+}
+
+void FusionDriver::warn(std::string message) {
+  if (warnings_.size() < kMaxPendingWarnings) {
+    warnings_.push_back(std::move(message));
+  } else if (warnings_.size() == kMaxPendingWarnings) {
+    warnings_.emplace_back("more warnings were left out");
+  }
 }
 
 void FusionDriver::emit_step(Samples& out) {
   fusion_->advance_to(next_output_ns_);
   const fusion::BodyEstimate e = fusion_->estimate();
-  if (e.valid) out.push_back({e.stamp_ns, e.pose, e.velocity_body_m_s});
+  // the filter's grid starts at its initialisation: an output instant before its first step
+  // would repeat the initial state's stamp
+  if (e.valid && (!last_output_ns_ || e.stamp_ns > *last_output_ns_)) {
+    out.push_back({e.stamp_ns, e.pose, e.velocity_body_m_s});
+    last_output_ns_ = e.stamp_ns;
+  }
   next_output_ns_ += fusion_->step_ns();
 }
 
+ImuSample FusionDriver::in_si_units(const ImuSample& sample) const {
+  ImuSample s = sample;
+  s.gyro_rad_s *= gyro_unit_.scale();
+  return s;
+}
+
+void FusionDriver::restart_fusion(const std::deque<ImuSample>& samples, bool regrid) {
+  fusion_.emplace(fusion_config_, gravity_m_s2_);
+  ++fusion_restarts_;
+  if (regrid) {
+    next_output_ns_ = 0;
+    last_output_ns_.reset();
+  }
+  for (const ImuSample& s : samples) fusion_->add_imu(in_si_units(s));
+  if (!samples.empty()) fusion_->advance_to(samples.back().stamp_ns);
+}
+
+bool FusionDriver::admit(const ImuSample& sample) {
+  if (newest_imu_ns_) {
+    // in seconds: the difference of two arbitrary int64 stamps may not fit an int64
+    const double jump_s = ns_to_seconds(sample.stamp_ns) - ns_to_seconds(*newest_imu_ns_);
+    if (std::abs(jump_s) > fusion_config_.max_bridged_gap_s) {
+      warn("IMU stamp " + seconds_text(ns_to_seconds(sample.stamp_ns)) + " s jumps by " + seconds_text(jump_s) +
+           " s from the newest (" + seconds_text(ns_to_seconds(*newest_imu_ns_)) +
+           " s), beyond fusion.max_bridged_gap_s (" + seconds_text(fusion_config_.max_bridged_gap_s) +
+           " s): the fusion is reset and starts again from the next LiDAR result");
+      recent_imu_.clear();
+      gyro_unit_.forget_samples();
+      restart_fusion(recent_imu_, /*regrid=*/true);
+      clock_ns_ = sample.stamp_ns;
+    } else if (sample.stamp_ns < *newest_imu_ns_) {
+      fusion_->add_imu(sample);  // older than the newest: the fusion drops and counts it
+      return false;
+    }
+  }
+  newest_imu_ns_ = sample.stamp_ns;
+  if (first_accels_.size() < static_cast<std::size_t>(fusion_config_.accel_unit_detection_samples)) {
+    first_accels_.push_back(sample.accel_m_s2);
+    if (first_accels_.size() == static_cast<std::size_t>(fusion_config_.accel_unit_detection_samples)) {
+      if (std::string silent = fusion::silent_accelerometer(first_accels_); !silent.empty()) {
+        warn(std::move(silent));
+        fusion_.reset();
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
 void FusionDriver::add_imu(const ImuSample& sample, Samples& out) {
-  if (!fusion_) return;
-  if (startup_imu_.empty() || in_gravity_window(startup_imu_.front(), sample)) startup_imu_.push_back(sample);
+  if (!fusion_ || !admit(sample)) return;
+  if (!gyro_unit_.decided()) {
+    gyro_unit_.add_imu(sample);
+    recent_imu_.push_back(sample);
+    while (recent_imu_.front().stamp_ns < sample.stamp_ns - seconds_to_ns(fusion_config_.history_s)) {
+      recent_imu_.pop_front();
+    }
+  }
+  const ImuSample si = in_si_units(sample);
+  if (startup_imu_.empty() || in_gravity_window(startup_imu_.front(), si)) startup_imu_.push_back(si);
   // the output grid: whole multiples of the step, the first after the first sample
   const std::int64_t step_ns = fusion_->step_ns();
   if (next_output_ns_ == 0) next_output_ns_ = (sample.stamp_ns / step_ns + 1) * step_ns;
   while (next_output_ns_ < sample.stamp_ns) emit_step(out);  // instants before the sample: without it
-  fusion_->add_imu(sample);
+  fusion_->add_imu(si);
   advance_to(sample.stamp_ns, out);
 }
 
 void FusionDriver::advance_to(std::int64_t stamp_ns, Samples& out) {
   if (!fusion_) return;
+  clock_ns_ = std::max(clock_ns_, stamp_ns);
+  // beyond the newest sample the fusion predicts with its last input: at most the bridged gap
+  if (newest_imu_ns_ && *newest_imu_ns_ < std::numeric_limits<std::int64_t>::max() - max_bridged_gap_ns_) {
+    stamp_ns = std::min(stamp_ns, *newest_imu_ns_ + max_bridged_gap_ns_);
+  }
   while (next_output_ns_ != 0 && next_output_ns_ <= stamp_ns) emit_step(out);
   fusion_->advance_to(stamp_ns);
-  clock_ns_ = std::max(clock_ns_, stamp_ns);
+}
+
+void FusionDriver::apply_gyro_unit() {
+  switch (gyro_unit_.unit()) {
+    case fusion::GyroUnit::kDegreesPerSecond:
+      warn(gyro_unit_.message());
+      restart_fusion(recent_imu_, /*regrid=*/false);
+      fusion_->advance_to(clock_ns_);
+      break;
+    case fusion::GyroUnit::kStuck:
+      warn(gyro_unit_.message());
+      fusion_.reset();
+      break;
+    default: break;
+  }
+  recent_imu_.clear();
 }
 
 SE3 FusionDriver::start_pose(std::int64_t first_scan_end_ns) const {
@@ -96,6 +204,9 @@ SE3 FusionDriver::start_pose(std::int64_t first_scan_end_ns) const {
 ScanPrior FusionDriver::prior(const Scan& scan) const {
   ScanPrior prior;
   if (!fusion_ || !fusion_->initialized()) return prior;
+  // while the gyro's unit is undecided, a scan during which it turns is registered by the LiDAR
+  // alone: a deg/s gyro would turn the guess 57 times too far
+  if (gyro_unit_.turning(scan.start_stamp_ns, scan.end_stamp_ns)) return prior;
   if (const auto body = fusion_->pose_at(scan.end_stamp_ns)) {
     prior.guess = *body * T_imu_lidar_;
     prior.motion = motion_from_fusion(*fusion_, scan, *prior.guess, T_imu_lidar_);
@@ -115,8 +226,20 @@ void FusionDriver::link(const Scan& scan, OdometryFrame& frame) {
       covariance = registration::release_degenerate_directions(*covariance, *frame.degeneracy);
     }
   }
-  if (frame.drop_reason.empty() && fusion_) {
-    const std::int64_t stamp_ns = scan.end_stamp_ns;
+  const std::int64_t stamp_ns = scan.end_stamp_ns;
+  if (frame.drop_reason.empty() && fusion_ && has_imu() && !gyro_unit_.decided() && last_body_ &&
+      stamp_ns > last_body_->stamp_ns) {
+    gyro_unit_.add_lidar_rotation(last_body_->stamp_ns, stamp_ns,
+                                  (last_body_->pose.inverse() * frame.body_pose).angle_rad());
+    if (gyro_unit_.decided()) apply_gyro_unit();
+  }
+  if (frame.drop_reason.empty() && fusion_ && has_imu() && !fusion_->initialized() &&
+      ns_to_seconds(clock_ns_) - ns_to_seconds(stamp_ns) > fusion_config_.max_bridged_gap_s) {
+    frame.drop_reason =
+        "not fused: the scan ends " + seconds_text(ns_to_seconds(clock_ns_) - ns_to_seconds(stamp_ns)) +
+        " s before the IMU clock, beyond fusion.max_bridged_gap_s (do the IMU and LiDAR clocks differ?)";
+  }
+  if (frame.drop_reason.empty() && fusion_ && has_imu()) {
     Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
     std::optional<Eigen::Matrix3d> velocity_covariance;
     const bool has_velocity = last_body_.has_value() && stamp_ns > last_body_->stamp_ns;

@@ -13,9 +13,22 @@
 //     (possibly delayed) measurement with that covariance.
 // Without the fusion (LiDAR-only odometry) the clock is idle, the prior is empty and nothing is
 // fused; the drop rules still apply.
+// What the driver does not let through (docs/hardening.md, "Configuration and clocks"), each with a
+// warning (take_warnings):
+//   the IMU clock jumping by more than fusion.max_bridged_gap_s (a far-future stamp, a stamp far
+//     back): the fusion is reset and starts again from the next LiDAR result, so that no catch-up
+//     loop runs across the jump; a sample older than the newest within it is dropped, and no
+//     odometry stamp is emitted twice;
+//   a LiDAR result older than the IMU clock by more than fusion.max_bridged_gap_s does not
+//     initialise the filter (the IMU and LiDAR clocks differ);
+//   a gyro in deg/s is scaled (the fusion starts again), a stuck gyro or a silent accelerometer
+//     ends the fusion (LiDAR-only): fusion/gyro_unit_detector.hpp;
+//   results before the first IMU sample are not fused (no IMU yet: LiDAR-only until it comes).
 #include <cstdint>
+#include <deque>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "farlio/core/config.hpp"
@@ -23,6 +36,7 @@
 #include "farlio/core/trajectory.hpp"
 #include "farlio/core/types.hpp"
 #include "farlio/deskew/scan_motion.hpp"
+#include "farlio/fusion/gyro_unit_detector.hpp"
 #include "farlio/fusion/sensor_fusion.hpp"
 #include "farlio/pipeline/odometry_output.hpp"
 
@@ -48,17 +62,26 @@ class FusionDriver {
  public:
   using Samples = std::vector<OdometrySample>;
 
-  /// With `inertial` false the driver runs LiDAR-only (no fusion).
+  /// With `inertial` false the driver runs LiDAR-only (no fusion). Throws std::invalid_argument
+  /// naming the field when the config is invalid (validate_config) or gravity is not a magnitude
+  /// near Earth's (validate_gravity).
   FusionDriver(const Config& config, double gravity_m_s2, const SE3& T_imu_lidar, bool inertial);
 
   /// Feeds one IMU sample (in time order): appends to `out` the odometry sample of every output
-  /// instant before the sample's stamp, then of the one at its stamp.
+  /// instant before the sample's stamp, then of the one at its stamp (each stamp once).
   void add_imu(const ImuSample& sample, Samples& out);
   /// Moves the fusion clock to stamp_ns without new IMU data, appending the odometry samples up
-  /// to it (the replay, past the last sample it has fed).
+  /// to it (the replay, past the last sample it has fed); the fusion predicts at most
+  /// fusion.max_bridged_gap_s beyond the newest sample.
   void advance_to(std::int64_t stamp_ns, Samples& out);
-  /// Runs LiDAR-only from now on (the online odometry, when no IMU sample came before the first scan).
+  /// Runs LiDAR-only from now on.
   void stop_fusion() { fusion_.reset(); }
+  /// The warnings since the last call (a reset of the fusion, the gyro's unit, an unusable IMU).
+  [[nodiscard]] std::vector<std::string> take_warnings() { return std::exchange(warnings_, {}); }
+  /// fusion.max_bridged_gap_s: the largest jump of the IMU clock the fusion bridges.
+  [[nodiscard]] double max_bridged_gap_s() const { return fusion_config_.max_bridged_gap_s; }
+  /// How often the fusion was started again (a clock jump, a gyro in deg/s).
+  [[nodiscard]] int fusion_restarts() const { return fusion_restarts_; }
 
   [[nodiscard]] bool inertial() const { return fusion_.has_value(); }
   /// Whether an IMU sample has been fed.
@@ -82,15 +105,35 @@ class FusionDriver {
  private:
   /// Steps the filter to the next output instant and appends its estimate.
   void emit_step(Samples& out);
+  /// A new filter (not initialised) fed with `samples`; the output grid is kept unless `regrid`.
+  void restart_fusion(const std::deque<ImuSample>& samples, bool regrid);
+  /// Whether `sample` may reach the fusion: false for a sample older than the newest (dropped)
+  /// and for a silent accelerometer; a jump beyond max_bridged_gap_s restarts the fusion first.
+  bool admit(const ImuSample& sample);
+  /// After the gyro unit was decided: scales and restarts, or ends the fusion.
+  void apply_gyro_unit();
+  /// The sample with its gyro in rad/s.
+  [[nodiscard]] ImuSample in_si_units(const ImuSample& sample) const;
+  void warn(std::string message);
 
   RegistrationConfig registration_config_;
+  FusionConfig fusion_config_;
+  double gravity_m_s2_;
+  std::int64_t max_bridged_gap_ns_;
   SE3 T_imu_lidar_;
   std::optional<fusion::SensorFusion> fusion_;
-  std::vector<ImuSample> startup_imu_;  ///< the first kGravityAlignmentWindow_s, for the start pose
+  fusion::GyroUnitDetector gyro_unit_;
+  std::vector<ImuSample> startup_imu_;         ///< the first kGravityAlignmentWindow_s, for the start pose
+  std::vector<Eigen::Vector3d> first_accels_;  ///< for the silent accelerometer check
+  std::deque<ImuSample> recent_imu_;           ///< raw, the last history_s, re-fed when the gyro's unit changes
+  std::optional<std::int64_t> newest_imu_ns_;
   std::int64_t clock_ns_ = 0;
-  std::int64_t next_output_ns_ = 0;       ///< 0: set by the first IMU sample
+  std::int64_t next_output_ns_ = 0;  ///< 0: set by the first IMU sample
+  std::optional<std::int64_t> last_output_ns_;
   std::optional<StampedPose> last_body_;  ///< the previous processed scan's body pose
   std::optional<Mat6d> last_covariance_;  ///< and its registration covariance
+  std::vector<std::string> warnings_;
+  int fusion_restarts_ = 0;
 };
 
 }  // namespace farlio::pipeline

@@ -1,10 +1,49 @@
 #include "farlio/pipeline/odometry.hpp"
 
 #include <algorithm>
+#include <stdexcept>
 
+#include "farlio/core/clock_check.hpp"
+#include "farlio/core/error.hpp"
 #include "farlio/core/time.hpp"
+#include "farlio/fusion/gyro_unit_detector.hpp"
 
 namespace farlio::pipeline {
+namespace {
+
+void check_latency(double value_s, const char* name) {
+  if (value_s >= 0.0 && value_s <= kMaxDuration_s) return;  // false for NaN
+  throw std::invalid_argument(std::string("ReplayOptions.") + name + " must be in [0, " +
+                              std::to_string(static_cast<int>(kMaxDuration_s)) + "] s, got " + std::to_string(value_s));
+}
+
+bool earlier(const ImuSample& a, const ImuSample& b) { return a.stamp_ns < b.stamp_ns; }
+
+/// Sorts the samples by stamp; a warning when they were not.
+void sort_by_stamp(std::vector<ImuSample>& imu, std::vector<std::string>& warnings) {
+  std::size_t out_of_order = 0;
+  for (std::size_t i = 1; i < imu.size(); ++i) out_of_order += earlier(imu[i], imu[i - 1]) ? 1 : 0;
+  if (out_of_order == 0) return;
+  std::stable_sort(imu.begin(), imu.end(), earlier);
+  warnings.push_back("IMU samples are not in time order (" + std::to_string(out_of_order) + " of " +
+                     std::to_string(imu.size()) + " are older than the sample before them): sorted by stamp");
+}
+
+/// The accelerometers of the first samples the unit detection looks at.
+std::vector<Eigen::Vector3d> first_accels(const std::vector<ImuSample>& imu, int count) {
+  std::vector<Eigen::Vector3d> out;
+  for (std::size_t i = 0; i < imu.size() && out.size() < static_cast<std::size_t>(count); ++i) {
+    out.push_back(imu[i].accel_m_s2);
+  }
+  return out;
+}
+
+}  // namespace
+
+void validate_replay_options(const ReplayOptions& options) {
+  check_latency(options.fixed_latency_s, "fixed_latency_s");
+  check_latency(options.added_delay_s, "added_delay_s");
+}
 
 Odometry::Odometry(const Config& config, const SE3& T_imu_lidar, double gravity_m_s2, std::vector<ImuSample> imu,
                    const ReplayOptions& options)
@@ -14,12 +53,20 @@ Odometry::Odometry(const Config& config, const SE3& T_imu_lidar, double gravity_
       imu_(std::move(imu)),
       driver_(config, gravity_m_s2, T_imu_lidar, config.fusion.enabled && !imu_.empty()),
       pipeline_(config, T_imu_lidar) {
-  if (driver_.inertial()) {
-    // the clock starts at the first IMU sample, so the fusion sees every sample before the
-    // first scan on its grid (as the online odometry does)
-    clock_started_ = true;
-    clock_ns_ = imu_.front().stamp_ns;
+  validate_replay_options(options_);
+  if (!driver_.inertial()) return;
+  sort_by_stamp(imu_, warnings_);
+  if (std::string silent = fusion::silent_accelerometer(first_accels(imu_, config.fusion.accel_unit_detection_samples));
+      !silent.empty()) {
+    warnings_.push_back(std::move(silent));
+    driver_.stop_fusion();
   }
+}
+
+std::vector<std::string> Odometry::take_warnings() {
+  std::vector<std::string> out = std::exchange(warnings_, {});
+  for (std::string& w : driver_.take_warnings()) out.push_back(std::move(w));
+  return out;
 }
 
 std::optional<fusion::FusionStats> Odometry::fusion_stats() const { return driver_.stats(); }
@@ -58,6 +105,16 @@ double Odometry::latency_s(const FrameResult& r) const {
 
 OdometryFrame Odometry::process(const Scan& scan) {
   if (scan.end_stamp_ns < busy_until_ns_) return busy_frame(scan);
+  if (!clock_started_ && driver_.inertial()) {
+    // the clock starts at the first IMU sample, so the fusion sees every sample before the
+    // first scan on its grid (as the online odometry does), or at a first scan before the IMU
+    const double tolerance_s = driver_.max_bridged_gap_s();
+    const ClockCheck check = check_clocks({imu_.front().stamp_ns, imu_.back().stamp_ns},
+                                          {scan.end_stamp_ns, scan.end_stamp_ns}, tolerance_s);
+    if (!check.error.empty() && scan.end_stamp_ns > imu_.back().stamp_ns) throw InputError("Odometry: " + check.error);
+    clock_started_ = true;
+    clock_ns_ = std::min(imu_.front().stamp_ns, scan.end_stamp_ns);
+  }
   OdometryFrame out;
   out.started_ns = std::max(scan.end_stamp_ns, clock_ns_);
   advance_clock(out.started_ns);

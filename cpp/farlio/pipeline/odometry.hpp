@@ -12,6 +12,10 @@
 // A scan that arrives while the pipeline is still busy, or whose registration ran out of its
 // time budget, is dropped (as in the paper). Without IMU samples, or with fusion.enabled off,
 // the scan pipeline runs alone on its constant-velocity model (LiDAR-only odometry).
+// The clock starts at the first IMU sample, or at the first scan when that ends earlier: scans
+// before the IMU starts run LiDAR-only (as in the online odometry), the fusion takes over from
+// the first scan after it. IMU samples out of time order are sorted (with a warning); a first
+// scan after the IMU's last sample is an InputError (the clocks do not overlap).
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -34,10 +38,13 @@ struct ReplayOptions {
   double fixed_latency_s = 0.0;  ///< with LatencyModel::Fixed
   double added_delay_s = 0.0;    ///< added to every result's latency (latency sweeps)
 };
+/// Throws std::invalid_argument naming the option unless both latencies are in [0, kMaxDuration_s].
+void validate_replay_options(const ReplayOptions& options);
 
 class Odometry {
  public:
-  /// `imu`: all samples of the recording in time order (empty: LiDAR-only).
+  /// `imu`: all samples of the recording (empty: LiDAR-only). Throws std::invalid_argument naming
+  /// the field for an invalid config, gravity or options.
   Odometry(const Config& config, const SE3& T_imu_lidar, double gravity_m_s2, std::vector<ImuSample> imu,
            const ReplayOptions& options = {});
 
@@ -50,6 +57,8 @@ class Odometry {
   std::function<void(const OdometrySample&)> on_odometry;
 
   [[nodiscard]] bool inertial() const { return driver_.inertial(); }
+  /// What was tolerated since the last call (sorted IMU, an unusable IMU, a reset of the fusion).
+  [[nodiscard]] std::vector<std::string> take_warnings();
   [[nodiscard]] const ScanPipeline& scan_pipeline() const { return pipeline_; }
   [[nodiscard]] std::optional<fusion::FusionStats> fusion_stats() const;
   /// The body pose the world frame starts from (roll and pitch from gravity when inertial, set
@@ -70,6 +79,7 @@ class Odometry {
   bool clock_started_ = false;
   std::int64_t clock_ns_ = 0;
   std::int64_t busy_until_ns_ = 0;
+  std::vector<std::string> warnings_;
   FusionDriver::Samples outputs_;  ///< reused buffer of the odometry samples of one clock advance
 };
 

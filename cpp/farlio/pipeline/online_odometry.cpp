@@ -90,13 +90,12 @@ OdometryFrame OnlineOdometry::process(const Scan& scan) {
   std::unique_lock pipeline_lock(pipeline_mutex_);
   {
     std::lock_guard lock(state_mutex_);
-    if (!mode_decided_) {  // the first scan fixes the mode and the start pose
-      mode_decided_ = true;
-      if (!driver_.has_imu()) driver_.stop_fusion();
+    if (!started_) {  // the first scan fixes the start pose (gravity aligned when the IMU came first)
+      started_ = true;
       pipeline_.reset_initial_pose(driver_.start_pose(scan.end_stamp_ns) * T_imu_lidar_);
     }
     prior = driver_.prior(scan);
-    out.started_ns = driver_.inertial() ? driver_.clock_ns() : scan.end_stamp_ns;
+    out.started_ns = fused_clock() ? driver_.clock_ns() : scan.end_stamp_ns;
   }
   out.guess_from_fusion = prior.guess.has_value();
   out.scan = pipeline_.process(scan, prior.guess, prior.motion);
@@ -114,19 +113,26 @@ OdometryFrame OnlineOdometry::process(const Scan& scan) {
   driver_.link(scan, out);
   // without the fusion there is no clock but the scan stamps: the result is ready after its
   // processing time
-  out.available_ns = driver_.inertial() ? driver_.clock_ns() : out.started_ns + seconds_to_ns(out.scan.timings.total_s);
+  out.available_ns = fused_clock() ? driver_.clock_ns() : out.started_ns + seconds_to_ns(out.scan.timings.total_s);
   return out;
 }
 
+bool OnlineOdometry::fused_clock() const { return driver_.inertial() && driver_.has_imu(); }
+
 bool OnlineOdometry::inertial() const {
   std::lock_guard lock(state_mutex_);
-  return mode_decided_ && driver_.inertial();
+  return fused_clock();
 }
 
 std::optional<fusion::FusionStats> OnlineOdometry::fusion_stats() const {
   std::lock_guard lock(state_mutex_);
-  if (!mode_decided_) return std::nullopt;
+  if (!started_) return std::nullopt;
   return driver_.stats();
+}
+
+std::vector<std::string> OnlineOdometry::take_warnings() {
+  std::lock_guard lock(state_mutex_);
+  return driver_.take_warnings();
 }
 
 map::MapSnapshot OnlineOdometry::map_snapshot() const {

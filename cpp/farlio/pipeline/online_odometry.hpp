@@ -8,9 +8,13 @@
 // Threads: add_imu() and add_scan() may be called from any threads (each kind in time order).
 // on_odometry runs on the thread that called add_imu(); on_frame runs on the worker (or on the
 // add_scan() caller for a dropped scan). Callbacks must not call back into the object.
-// A scan that arrives while the worker is still busy is dropped (as in the paper). Without an
-// IMU sample before the first scan, or with fusion.enabled off, the odometry is LiDAR-only and
-// on_odometry is not called.
+// A scan that arrives while the worker is still busy is dropped (as in the paper). With
+// fusion.enabled off, or until the first IMU sample arrives, the odometry is LiDAR-only and
+// on_odometry is not called; the fusion takes over with the first scan after the first IMU
+// sample (scans before it are registered, not fused; the world frame is then not gravity
+// aligned, as in the replay). IMU samples that jump in time are handled by the driver
+// (fusion_driver.hpp): no catch-up across a jump, no stamp emitted twice; take_warnings()
+// reports what happened.
 // With keep_registered_points, every processed frame carries its registered scan (world frame),
 // for a live view; map_snapshot() copies the submap between two scans.
 #include <condition_variable>
@@ -18,6 +22,7 @@
 #include <functional>
 #include <mutex>
 #include <optional>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -51,8 +56,11 @@ class OnlineOdometry {
   /// Finishes the scan in progress, then ends the worker (also done by the destructor).
   void stop();
 
-  /// Whether the fusion is in use (decided at the first scan).
+  /// Whether the fusion is in use: enabled, IMU samples have arrived, and the IMU was not found
+  /// unusable (a silent accelerometer, a stuck gyro).
   [[nodiscard]] bool inertial() const;
+  /// The warnings since the last call (a reset of the fusion, the gyro's unit, an unusable IMU).
+  [[nodiscard]] std::vector<std::string> take_warnings();
   [[nodiscard]] std::optional<fusion::FusionStats> fusion_stats() const;
   /// Scans dropped because the worker was busy.
   [[nodiscard]] std::size_t scans_dropped_busy() const;
@@ -67,6 +75,8 @@ class OnlineOdometry {
  private:
   void worker_loop();
   OdometryFrame process(const Scan& scan);
+  /// Whether time is the IMU's (the fusion runs and has samples), else the scan stamps'.
+  [[nodiscard]] bool fused_clock() const;
 
   const Config config_;
   const SE3 T_imu_lidar_, T_lidar_imu_;
@@ -77,7 +87,7 @@ class OnlineOdometry {
   // fusion state, guarded by state_mutex_
   mutable std::mutex state_mutex_;
   FusionDriver driver_;
-  bool mode_decided_ = false;  ///< inertial or LiDAR-only, decided at the first scan
+  bool started_ = false;  ///< the first scan has set the start pose
   std::size_t dropped_busy_ = 0;
 
   std::mutex emit_mutex_;  // keeps on_odometry calls in order

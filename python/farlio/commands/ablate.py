@@ -6,13 +6,14 @@ import argparse
 from pathlib import Path
 
 from farlio.ablation import ABLATION_ROWS, ablate
+from farlio.cli_args import positive_int
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("path", type=Path, help="a recording with IMU and ground truth (e.g. farlio simulate output)")
     parser.add_argument("--out", type=Path, required=True, help="output folder: ablation.csv/.md and one run per row")
     parser.add_argument("--latency", default="measured", choices=["measured", "zero"], help="replay latency model")
-    parser.add_argument("--max-frames", type=int, default=None, help="stop each run after this many scans")
+    parser.add_argument("--max-frames", type=positive_int, default=None, help="stop each run after this many scans")
 
 
 def run(args: argparse.Namespace) -> int:

@@ -7,6 +7,7 @@ import json
 from pathlib import Path
 
 from farlio.benchmark import compare, format_table, generated_scans
+from farlio.cli_args import non_negative_int, positive_int
 from farlio.datasets import open_dataset
 from farlio.runner import DEVICES
 from farlio.simulation import PROFILES
@@ -19,7 +20,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         choices=PROFILES,
         help="generated scans of this profile (repeatable; default: urban)",
     )
-    parser.add_argument("--scans", type=int, default=100, help="frames per data set")
+    parser.add_argument("--scans", type=positive_int, default=100, help="frames per data set")
     parser.add_argument(
         "--data",
         type=Path,
@@ -27,7 +28,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default=[],
         help="also a recording (any format farlio run reads; repeatable)",
     )
-    parser.add_argument("--threads", type=int, default=0, help="threads for both systems (0: all)")
+    parser.add_argument("--threads", type=non_negative_int, default=0, help="threads for both systems (0: all)")
     parser.add_argument(
         "--device",
         choices=DEVICES,

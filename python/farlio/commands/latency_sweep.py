@@ -6,6 +6,7 @@ import argparse
 from pathlib import Path
 
 from farlio.ablation import latency_sweep
+from farlio.cli_args import non_negative_float, positive_int
 
 DEFAULT_DELAYS_MS = [0, 20, 40, 60, 80, 100, 150, 200, 300]
 
@@ -15,12 +16,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", type=Path, required=True, help="output folder: latency_sweep.csv/.md/.png")
     parser.add_argument(
         "--delays-ms",
-        type=float,
+        type=non_negative_float,
         nargs="+",
         default=DEFAULT_DELAYS_MS,
         help="delays added to the measured processing time",
     )
-    parser.add_argument("--max-frames", type=int, default=None, help="stop each run after this many scans")
+    parser.add_argument("--max-frames", type=positive_int, default=None, help="stop each run after this many scans")
     parser.add_argument("--no-plot", action="store_true", help="no latency_sweep.png")
 
 

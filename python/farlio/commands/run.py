@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from farlio.cli_args import non_negative_float, non_negative_int, positive_int
 from farlio.config import load_config
 from farlio.datasets import FORMAT_HELP, FORMATS, LoadOptions, TimeOptions, open_dataset
 from farlio.datasets.pointcloud2 import HEADER_STAMPS, TIME_FIELDS, TIME_UNITS
@@ -24,7 +25,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="KEY=VALUE",
         help="override one config field, e.g. --set map.voxel_size_m=2 (repeatable)",
     )
-    parser.add_argument("--threads", type=int, default=None, help="CPU threads (default: all; = num_threads)")
+    parser.add_argument(
+        "--threads", type=non_negative_int, default=None, help="CPU threads (default: all; = num_threads)"
+    )
     parser.add_argument(
         "--device",
         choices=DEVICES,
@@ -32,7 +35,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="scan pipeline backend (= the config field device, default auto): auto takes the GPU "
         "when one is present and falls back to the CPU with a message; cuda without one is an error",
     )
-    parser.add_argument("--max-frames", type=int, default=None, help="stop after this many scans")
+    parser.add_argument("--max-frames", type=positive_int, default=None, help="stop after this many scans")
     parser.add_argument(
         "--gt",
         type=Path,
@@ -99,9 +102,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="replay latency model: a scan's result reaches the fusion after its measured "
         "processing time, at once, or after --fixed-latency",
     )
-    parser.add_argument("--fixed-latency", type=float, default=0.0, metavar="S", help="latency with --latency fixed")
     parser.add_argument(
-        "--added-delay", type=float, default=0.0, metavar="S", help="extra delay added to every result (latency sweeps)"
+        "--fixed-latency", type=non_negative_float, default=0.0, metavar="S", help="latency with --latency fixed"
+    )
+    parser.add_argument(
+        "--added-delay",
+        type=non_negative_float,
+        default=0.0,
+        metavar="S",
+        help="extra delay added to every result (latency sweeps)",
     )
     parser.add_argument(
         "--save-map", action="store_true", help="write the final submap (world frame) as map.ply and map.pcd"

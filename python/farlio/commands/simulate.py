@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from farlio.cli_args import non_negative_float, non_negative_int, positive_float, probability
 from farlio.progress import Progress
 from farlio.simulation import IMU_GRADES, PROFILES, make_config, write_sequence
 
@@ -19,9 +20,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "middle is degenerate along the track (docs/simulation.md)",
     )
     parser.add_argument("--out", type=Path, required=True, help="output sequence folder (created)")
-    parser.add_argument("--seed", type=int, default=1, help="noise seed (the scene and trajectory are fixed)")
     parser.add_argument(
-        "--duration", type=float, default=None, help="seconds to generate (default: the profile's, docs/simulation.md)"
+        "--seed", type=non_negative_int, default=1, help="noise seed (the scene and trajectory are fixed)"
+    )
+    parser.add_argument(
+        "--duration",
+        type=positive_float,
+        default=None,
+        help="seconds to generate (default: the profile's, docs/simulation.md)",
     )
     parser.add_argument("--noise-free", action="store_true", help="exact ranges, no dropout, IMU without noise/bias")
     parser.add_argument(
@@ -36,10 +42,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--no-vibration", action="store_true", help="with a datasheet --imu-grade: leave out the platform vibration"
     )
-    parser.add_argument("--range-noise", type=float, default=None, metavar="M", help="range noise std (m)")
-    parser.add_argument("--dropout", type=float, default=None, metavar="P", help="chance a ray returns nothing")
-    parser.add_argument("--gyro-noise", type=float, default=None, metavar="RAD_S", help="gyro white noise std")
-    parser.add_argument("--accel-noise", type=float, default=None, metavar="M_S2", help="accel white noise std")
+    parser.add_argument("--range-noise", type=non_negative_float, default=None, metavar="M", help="range noise std (m)")
+    parser.add_argument("--dropout", type=probability, default=None, metavar="P", help="chance a ray returns nothing")
+    parser.add_argument(
+        "--gyro-noise", type=non_negative_float, default=None, metavar="RAD_S", help="gyro white noise std"
+    )
+    parser.add_argument(
+        "--accel-noise", type=non_negative_float, default=None, metavar="M_S2", help="accel white noise std"
+    )
     parser.add_argument(
         "--kitti",
         action="store_true",

@@ -53,6 +53,11 @@ class Dataset:
         """All IMU samples in time order (empty: LiDAR-only)."""
         return []
 
+    def scan_end_stamps_ns(self) -> list[int] | None:
+        """The end stamps of all scans when they are known without reading the scans (file names,
+        times files), for the clock check before a run; None otherwise (bags, Ouster)."""
+        return None
+
     def T_imu_lidar(self) -> farlio.SE3:
         """Maps LiDAR points into the IMU (body) frame; identity when unknown."""
         return farlio.SE3()

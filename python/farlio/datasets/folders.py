@@ -48,6 +48,9 @@ class SequenceFolder(Dataset):
     def scan_source(self, i: int) -> str:
         return str(self._reader.scan_path(i))
 
+    def scan_end_stamps_ns(self) -> list[int] | None:
+        return [self._reader.scan_end_stamp_ns(i) for i in range(len(self))]
+
     def imu(self) -> list[farlio.ImuSample]:
         return self._reader.imu() if self._reader.has_imu() else []
 
@@ -97,6 +100,9 @@ class _FilesWithStamps(Dataset):
 
     def scan_source(self, i: int) -> str:
         return str(self._files[i])
+
+    def scan_end_stamps_ns(self) -> list[int] | None:
+        return list(self._stamps)
 
 
 class KittiOdometry(_FilesWithStamps):

@@ -1,0 +1,59 @@
+#pragma once
+// A generated recording held in memory for the odometry tests: scans thinned to keep sanitizer
+// runs short, the IMU, the extrinsic and gravity; and a config whose results do not depend on
+// how fast the machine is.
+#include <limits>
+#include <vector>
+
+#include "farlio/core/config.hpp"
+#include "farlio/core/se3.hpp"
+#include "farlio/core/types.hpp"
+#include "farlio/sim/sequence_generator.hpp"
+
+namespace farlio::test {
+
+struct Recording {
+  std::vector<Scan> scans;
+  std::vector<ImuSample> imu;
+  std::vector<SE3> body_at_scan_end;  ///< ground truth
+  SE3 T_imu_lidar;
+  double gravity_m_s2 = 0;
+};
+
+/// Every k-th point of a scan with its time, intensity and sensor id.
+inline Scan thinned(const Scan& s, std::size_t k) {
+  Scan out;
+  out.start_stamp_ns = s.start_stamp_ns;
+  out.end_stamp_ns = s.end_stamp_ns;
+  for (std::size_t i = 0; i < s.size(); i += k) {
+    out.points.push_back(s.points[i]);
+    if (!s.time_s.empty()) out.time_s.push_back(s.time_s[i]);
+    if (!s.intensity.empty()) out.intensity.push_back(s.intensity[i]);
+    if (!s.sensor_id.empty()) out.sensor_id.push_back(s.sensor_id[i]);
+  }
+  return out;
+}
+
+/// `duration_s` of a profile, every `keep_every`-th point of each scan.
+inline Recording record(sim::Profile profile, double duration_s, std::size_t keep_every) {
+  sim::SimConfig cfg = sim::default_config(profile);
+  cfg.duration_s = duration_s;
+  const sim::SequenceGenerator gen(cfg);
+  Recording r;
+  for (std::size_t i = 0; i < gen.num_scans(); ++i) r.scans.push_back(thinned(gen.scan(i), keep_every));
+  for (const auto& p : gen.groundtruth_scans()) r.body_at_scan_end.push_back(p.pose);
+  r.imu = gen.imu();
+  r.T_imu_lidar = gen.T_imu_lidar();
+  r.gravity_m_s2 = gen.gravity_m_s2();
+  return r;
+}
+
+/// Results that do not depend on how fast this machine is: no registration time budget (a slow
+/// sanitizer build would otherwise drop frames the replay keeps, or the other way round).
+inline Config deterministic_config() {
+  Config c;
+  c.registration.time_budget_factor = std::numeric_limits<double>::infinity();
+  return c;
+}
+
+}  // namespace farlio::test

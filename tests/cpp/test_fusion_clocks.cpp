@@ -1,0 +1,498 @@
+// The fusion's clock and the IMU's units (docs/hardening.md, "Configuration and clocks"): spans
+// of IMU and scan stamps that do not overlap are named with the unit that would make them; the
+// IMU clock jumping far ahead or back resets the fusion instead of dead-reckoning across the
+// jump; out-of-order samples never repeat an output stamp; the replay sorts unsorted IMU and runs
+// scans before the IMU LiDAR-only; a gyro in deg/s is scaled, a stuck gyro and a silent
+// accelerometer end the fusion, each with a warning.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <mutex>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "farlio/core/clock_check.hpp"
+#include "farlio/core/error.hpp"
+#include "farlio/core/time.hpp"
+#include "farlio/fusion/gyro_unit_detector.hpp"
+#include "farlio/pipeline/odometry.hpp"
+#include "farlio/pipeline/online_odometry.hpp"
+#include "sim_recording.hpp"
+
+using namespace farlio;
+using namespace farlio::pipeline;
+using test::deterministic_config;
+using test::Recording;
+
+namespace {
+
+constexpr double kDegPerRad = 180.0 / std::numbers::pi;
+constexpr std::int64_t kNsPerUs = 1000;
+constexpr std::size_t kKeepEvery = 4;  // every 4th point keeps sanitizer runs short
+
+const Recording& urban() {  // 15 scans, a straight road
+  static const Recording r = test::record(sim::Profile::Urban, 1.5, kKeepEvery);
+  return r;
+}
+
+const Recording& handheld() {  // 50 scans through rooms: the sensor turns from 2.2 s on
+  static const Recording r = test::record(sim::Profile::Handheld, 5.0, kKeepEvery);
+  return r;
+}
+
+/// Decides the gyro's unit after 0.15 rad (the handheld's first turn) instead of the default.
+Config quick_gyro_unit_config() {
+  Config c = deterministic_config();
+  c.fusion.gyro_unit_min_rotation_rad = 0.15;
+  return c;
+}
+
+bool contains(const std::vector<std::string>& warnings, const std::string& fragment) {
+  return std::any_of(warnings.begin(), warnings.end(),
+                     [&](const std::string& w) { return w.find(fragment) != std::string::npos; });
+}
+
+std::string joined(const std::vector<std::string>& warnings) {
+  std::string s;
+  for (const auto& w : warnings) s += w + "\n";
+  return s;
+}
+
+/// The replay of `rec` (zero latency) with its IMU replaced; frames, outputs and warnings.
+struct ReplayRun {
+  std::vector<OdometryFrame> frames;
+  std::vector<OdometrySample> outputs;
+  std::vector<std::string> warnings;
+  bool inertial_at_end = false;
+};
+
+ReplayRun replay(const Recording& rec, std::vector<ImuSample> imu, const std::vector<Scan>* scans = nullptr,
+                 const Config& config = deterministic_config()) {
+  ReplayOptions zero;
+  zero.latency = LatencyModel::Zero;
+  Odometry odo(config, rec.T_imu_lidar, rec.gravity_m_s2, std::move(imu), zero);
+  ReplayRun run;
+  odo.on_odometry = [&](const OdometrySample& s) { run.outputs.push_back(s); };
+  for (const Scan& s : scans ? *scans : rec.scans) run.frames.push_back(odo.process(s));
+  odo.finish((scans ? *scans : rec.scans).back().end_stamp_ns);
+  run.warnings = odo.take_warnings();
+  run.inertial_at_end = odo.inertial();
+  return run;
+}
+
+double final_position_error_m(const Recording& rec, const ReplayRun& run) {
+  // both start at the first scan's pose: compare the motion since then
+  const SE3 truth = rec.body_at_scan_end.front().inverse() * rec.body_at_scan_end.back();
+  const SE3 estimate = run.frames.front().body_pose.inverse() * run.frames.back().body_pose;
+  return (truth.translation() - estimate.translation()).norm();
+}
+
+/// Pushes the IMU and the scans of `rec` to an online odometry in stamp order, scan by scan
+/// (each scan after the IMU up to its end), applying `imu_at(i)` to choose the sample pushed i-th.
+struct OnlineRun {
+  std::vector<OdometrySample> outputs;
+  std::vector<OdometryFrame> frames;
+  std::vector<std::string> warnings;
+  bool inertial = false;
+};
+
+template <typename Push>
+OnlineRun online_run(const Recording& rec, Push&& push) {
+  OnlineRun run;
+  std::mutex m;
+  OnlineOdometry online(
+      deterministic_config(), rec.T_imu_lidar, rec.gravity_m_s2,
+      [&](const OdometrySample& s) { run.outputs.push_back(s); },
+      [&](const OdometryFrame& f) {
+        std::lock_guard lock(m);
+        run.frames.push_back(f);
+      });
+  push(online);
+  online.stop();
+  run.warnings = online.take_warnings();
+  run.inertial = online.inertial();
+  return run;
+}
+
+void push_scan(OnlineOdometry& online, const Scan& scan) {
+  online.add_scan(scan);
+  online.wait_idle();
+}
+
+void expect_increasing(const std::vector<OdometrySample>& outputs) {
+  for (std::size_t i = 1; i < outputs.size(); ++i) {
+    ASSERT_GT(outputs[i].stamp_ns, outputs[i - 1].stamp_ns) << "output " << i << " repeats or goes back";
+  }
+}
+
+}  // namespace
+
+// ---- the clock check ---------------------------------------------------------------------------
+
+TEST(ClockCheck, SpansOfOneClockPass) {
+  const ClockCheck c = check_clocks({1'700'000'000'000'000'000, 1'700'000'010'000'000'000},
+                                    {1'700'000'000'100'000'000, 1'700'000'010'000'000'000}, 1.0);
+  EXPECT_EQ(c.error, "");
+  EXPECT_TRUE(c.warnings.empty()) << joined(c.warnings);
+}
+
+TEST(ClockCheck, StampsInAnotherUnitAreNamed) {
+  const StampSpan imu_ns{1'700'000'000'000'000'000, 1'700'000'010'000'000'000};
+  const StampSpan scans_us{1'700'000'000'100'000, 1'700'000'010'000'000};
+  const ClockCheck scans = check_clocks(imu_ns, scans_us, 1.0);
+  EXPECT_NE(scans.error.find("IMU stamps span [1700000000.000, 1700000010.000] s, scans span [1700000.000, "
+                             "1700000.010] s: they do not overlap"),
+            std::string::npos)
+      << scans.error;
+  EXPECT_NE(scans.error.find("scan stamps would overlap the IMU: are the scans"), std::string::npos) << scans.error;
+  EXPECT_NE(scans.error.find("stamped in us?"), std::string::npos) << scans.error;
+
+  const StampSpan imu_us{1'700'000'000'000'000, 1'700'000'010'000'000};
+  const StampSpan scans_ns{1'700'000'000'100'000'000, 1'700'000'010'000'000'000};
+  const ClockCheck imu = check_clocks(imu_us, scans_ns, 1.0);
+  EXPECT_NE(imu.error.find("the IMU stamps would overlap the scans: is imu.csv (or the IMU topic) stamped in us?"),
+            std::string::npos)
+      << imu.error;
+}
+
+TEST(ClockCheck, AnOffsetOfSecondsIsAWarning) {
+  const StampSpan scans{1'700'000'000'100'000'000, 1'700'000'003'000'000'000};
+  const ClockCheck late = check_clocks({1'700'000'002'000'000'000, 1'700'000'005'000'000'000}, scans, 1.0);
+  EXPECT_EQ(late.error, "");
+  ASSERT_EQ(late.warnings.size(), 1u);
+  EXPECT_NE(late.warnings[0].find("the IMU starts 1.900 s after the first scan"), std::string::npos)
+      << late.warnings[0];
+  const ClockCheck early = check_clocks({1'699'999'998'000'000'000, 1'700'000'001'000'000'000}, scans, 1.0);
+  ASSERT_EQ(early.warnings.size(), 1u);
+  EXPECT_NE(early.warnings[0].find("the IMU ends 2.000 s before the last scan"), std::string::npos)
+      << early.warnings[0];
+  EXPECT_NE(check_clocks({1'700'000'010'000'000'000, 1'700'000'020'000'000'000}, scans, 1.0).error, "");
+}
+
+// ---- the gyro's unit ---------------------------------------------------------------------------
+
+namespace {
+
+/// Feeds `seconds` of a gyro turning at `rate_rad_s` about z (reported times `unit`, plus a
+/// bias) at 100 Hz and the LiDAR's rotation every 0.1 s.
+void turn(fusion::GyroUnitDetector& d, std::int64_t& t_ns, double seconds, double rate_rad_s, double unit,
+          double bias_rad_s = 0.0) {
+  constexpr std::int64_t kImuStepNs = 10'000'000, kScanNs = 100'000'000;
+  const std::int64_t end = t_ns + seconds_to_ns(seconds);
+  while (t_ns < end) {
+    const std::int64_t scan_start = t_ns;
+    for (; t_ns < scan_start + kScanNs; t_ns += kImuStepNs) {
+      ImuSample s;
+      s.stamp_ns = t_ns + kImuStepNs;
+      s.gyro_rad_s = Eigen::Vector3d(0.0, 0.0, rate_rad_s * unit + bias_rad_s);
+      s.accel_m_s2 = Eigen::Vector3d(0.0, 0.0, 9.81);
+      d.add_imu(s);
+    }
+    d.add_lidar_rotation(scan_start, t_ns, rate_rad_s * ns_to_seconds(kScanNs));
+  }
+}
+
+}  // namespace
+
+TEST(GyroUnit, DegreesPerSecondAreFoundAndScaled) {
+  fusion::GyroUnitDetector d(true, 0.3, 0.05);
+  std::int64_t t = 0;
+  turn(d, t, 0.4, 0.5, kDegPerRad);  // the LiDAR turned 0.15 rad (the first interval is not covered)
+  EXPECT_FALSE(d.decided());
+  EXPECT_TRUE(d.turning(0, t));  // meanwhile the fusion's guess is not used
+  turn(d, t, 0.4, 0.5, kDegPerRad);
+  ASSERT_EQ(d.unit(), fusion::GyroUnit::kDegreesPerSecond);
+  EXPECT_NEAR(d.scale(), 1.0 / kDegPerRad, 1e-12);
+  EXPECT_NE(d.message().find("the gyro reports in deg/s"), std::string::npos) << d.message();
+  EXPECT_FALSE(d.turning(0, t));  // decided: the guess is used again
+}
+
+TEST(GyroUnit, ABiasAtRestDoesNotLookLikeDegrees) {
+  // 30 s at rest with a 0.05 rad/s bias (3 deg/s: a poor gyro), then a turn: rad/s
+  fusion::GyroUnitDetector d(true, 0.3, 0.05);
+  std::int64_t t = 0;
+  turn(d, t, 30.0, 0.0, 1.0, 0.05);
+  EXPECT_FALSE(d.decided());
+  turn(d, t, 1.0, 0.5, 1.0, 0.05);
+  EXPECT_EQ(d.unit(), fusion::GyroUnit::kRadPerSecond);
+  EXPECT_EQ(d.scale(), 1.0);
+  EXPECT_EQ(d.message(), "");
+}
+
+TEST(GyroUnit, AStuckGyroIsFound) {
+  fusion::GyroUnitDetector d(true, 0.3, 0.05);
+  std::int64_t t = 0;
+  constexpr std::int64_t kScanNs = 100'000'000;
+  for (int k = 0; k < 20 && !d.decided(); ++k) {
+    for (int j = 1; j <= 10; ++j) {
+      ImuSample s;
+      s.stamp_ns = t + j * kScanNs / 10;
+      s.gyro_rad_s = Eigen::Vector3d(0.001, 0.0, 0.0);  // never changes
+      d.add_imu(s);
+    }
+    d.add_lidar_rotation(t, t + kScanNs, 0.05);  // the LiDAR turns 0.5 rad/s
+    t += kScanNs;
+  }
+  EXPECT_EQ(d.unit(), fusion::GyroUnit::kStuck);
+  EXPECT_NE(d.message().find("the gyro is stuck"), std::string::npos) << d.message();
+}
+
+TEST(GyroUnit, DisabledMeansRadPerSecond) {
+  const fusion::GyroUnitDetector d(false, 0.3, 0.05);
+  EXPECT_EQ(d.unit(), fusion::GyroUnit::kRadPerSecond);
+  EXPECT_FALSE(d.turning(0, 1'000'000'000));
+}
+
+TEST(GyroUnit, ASilentAccelerometerIsNamed) {
+  EXPECT_NE(fusion::silent_accelerometer(std::vector<Eigen::Vector3d>(50, Eigen::Vector3d::Zero()))
+                .find("the accelerometer reads zero"),
+            std::string::npos);
+  EXPECT_EQ(fusion::silent_accelerometer(std::vector<Eigen::Vector3d>(50, Eigen::Vector3d(0, 0, 9.81))), "");
+  EXPECT_EQ(fusion::silent_accelerometer(std::vector<Eigen::Vector3d>(50, Eigen::Vector3d(0, 0, 1.0))), "");  // in g
+  EXPECT_EQ(fusion::silent_accelerometer({}), "");
+}
+
+// ---- the replay --------------------------------------------------------------------------------
+
+TEST(ReplayClocks, UnsortedImuIsSortedWithAWarning) {
+  const Recording& rec = urban();
+  std::vector<ImuSample> shuffled = rec.imu;
+  for (std::size_t i = 10; i + 1 < shuffled.size(); i += 7) std::swap(shuffled[i], shuffled[i + 1]);
+  const ReplayRun sorted = replay(rec, rec.imu);
+  const ReplayRun run = replay(rec, shuffled);
+  EXPECT_TRUE(contains(run.warnings, "IMU samples are not in time order")) << joined(run.warnings);
+  ASSERT_EQ(run.frames.size(), sorted.frames.size());
+  for (std::size_t i = 0; i < run.frames.size(); ++i) {
+    EXPECT_TRUE(run.frames[i].processed) << "scan " << i << ": " << run.frames[i].drop_reason;
+    EXPECT_LT((run.frames[i].body_pose.translation() - sorted.frames[i].body_pose.translation()).norm(), 1e-9);
+  }
+}
+
+TEST(ReplayClocks, ScansBeforeTheImuRunLidarOnlyThenTheImuIsUsed) {
+  // the IMU's clock 0.5 s behind: the first five scans end before its first sample
+  const Recording& rec = urban();
+  std::vector<ImuSample> late = rec.imu;
+  for (auto& s : late) s.stamp_ns += 500'000'000;
+  const ReplayRun run = replay(rec, late);
+  int fused = 0;
+  for (const auto& f : run.frames) {
+    EXPECT_TRUE(f.processed) << f.drop_reason;  // none dropped as "still busy"
+    fused += f.fused ? 1 : 0;
+  }
+  EXPECT_FALSE(run.frames[2].fused);  // before the IMU: LiDAR-only
+  EXPECT_GE(fused, 5);
+  EXPECT_TRUE(run.inertial_at_end);
+  EXPECT_GT(run.outputs.size(), 50u);
+  expect_increasing(run.outputs);
+}
+
+TEST(ReplayClocks, ScansStampedInMicrosecondsRunLidarOnlyWithoutAHang) {
+  // before: the filter initialised at the first scan and stepped 10 ms at a time across the
+  // 1.7e9 s to the IMU's clock
+  const Recording& rec = urban();
+  std::vector<Scan> scans_us = rec.scans;
+  for (auto& s : scans_us) {  // named in us (no per-point times: they would not fit the 100 us period)
+    s.end_stamp_ns /= kNsPerUs;
+    s.start_stamp_ns = s.end_stamp_ns;
+    s.time_s.clear();
+  }
+  const ReplayRun run = replay(rec, rec.imu, &scans_us);
+  for (const auto& f : run.frames) {
+    EXPECT_TRUE(f.processed);
+    EXPECT_FALSE(f.fused);
+  }
+  EXPECT_TRUE(run.outputs.empty());
+}
+
+TEST(ReplayClocks, AFirstScanAfterTheImuEndsIsAnError) {
+  const Recording& rec = urban();
+  std::vector<ImuSample> imu_us = rec.imu;
+  for (auto& s : imu_us) s.stamp_ns /= kNsPerUs;
+  Odometry odo(deterministic_config(), rec.T_imu_lidar, rec.gravity_m_s2, imu_us);
+  try {
+    (void)odo.process(rec.scans.front());
+    FAIL() << "accepted";
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("they do not overlap"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("is imu.csv (or the IMU topic) stamped in us?"), std::string::npos) << msg;
+  }
+}
+
+TEST(ReplayClocks, AGyroInDegreesPerSecondIsScaled) {
+  const Recording& rec = handheld();
+  std::vector<ImuSample> deg = rec.imu;
+  for (auto& s : deg) s.gyro_rad_s *= kDegPerRad;
+  const ReplayRun normal = replay(rec, rec.imu, nullptr, quick_gyro_unit_config());
+  const ReplayRun run = replay(rec, deg, nullptr, quick_gyro_unit_config());
+  EXPECT_TRUE(contains(run.warnings, "the gyro reports in deg/s")) << joined(run.warnings);
+  EXPECT_FALSE(contains(normal.warnings, "the gyro")) << joined(normal.warnings);
+  EXPECT_TRUE(run.inertial_at_end);
+  // the run ends as accurate as with the gyro in rad/s
+  const double normal_m = final_position_error_m(rec, normal), deg_m = final_position_error_m(rec, run);
+  EXPECT_LT(deg_m, 2.0 * normal_m + 0.02) << "rad/s: " << normal_m << " m";
+}
+
+TEST(ReplayClocks, AStuckGyroEndsTheFusion) {
+  const Recording& rec = handheld();
+  std::vector<ImuSample> stuck = rec.imu;
+  for (auto& s : stuck) s.gyro_rad_s = Eigen::Vector3d(0.002, -0.001, 0.0);
+  const ReplayRun run = replay(rec, stuck, nullptr, quick_gyro_unit_config());
+  EXPECT_TRUE(contains(run.warnings, "the gyro is stuck")) << joined(run.warnings);
+  EXPECT_FALSE(run.inertial_at_end);
+  for (const auto& f : run.frames) EXPECT_TRUE(f.body_pose.translation().allFinite());
+}
+
+TEST(ReplayClocks, ASilentAccelerometerMeansLidarOnly) {
+  const Recording& rec = urban();
+  std::vector<ImuSample> silent = rec.imu;
+  for (auto& s : silent) s.accel_m_s2.setZero();
+  const ReplayRun run = replay(rec, silent);
+  EXPECT_TRUE(contains(run.warnings, "the accelerometer reads zero")) << joined(run.warnings);
+  EXPECT_FALSE(run.inertial_at_end);
+  EXPECT_TRUE(run.outputs.empty());
+}
+
+TEST(ReplayClocks, BadGravityAndLatenciesAreErrorsNamingThem) {
+  const Recording& rec = urban();
+  for (const double g : {-9.81, 0.0, 1.0}) {
+    try {
+      Odometry odo(Config{}, rec.T_imu_lidar, g, rec.imu);
+      ADD_FAILURE() << "gravity " << g << " accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("gravity_m_s2: must be the magnitude of gravity"), std::string::npos)
+          << e.what();
+    }
+  }
+  ReplayOptions negative;
+  negative.added_delay_s = -5.0;
+  try {
+    Odometry odo(Config{}, rec.T_imu_lidar, rec.gravity_m_s2, rec.imu, negative);
+    ADD_FAILURE() << "a negative delay was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("ReplayOptions.added_delay_s must be in [0, 60] s"), std::string::npos)
+        << e.what();
+  }
+}
+
+// ---- the online odometry -----------------------------------------------------------------------
+
+namespace {
+
+/// Pushes the recording in stamp order: the IMU up to each scan's end, then the scan;
+/// `sample(i)` is what is pushed for IMU sample i (it may push more).
+template <typename Sample>
+void push_in_order(OnlineOdometry& online, const Recording& rec, Sample&& sample) {
+  std::size_t next = 0;
+  for (const Scan& scan : rec.scans) {
+    while (next < rec.imu.size() && rec.imu[next].stamp_ns <= scan.end_stamp_ns) sample(online, next++);
+    push_scan(online, scan);
+  }
+  while (next < rec.imu.size()) sample(online, next++);
+}
+
+}  // namespace
+
+TEST(OnlineClocks, AFarFutureImuStampIsAResetNotADeadReckoning) {
+  // before: +10,000 s emitted 990,001 dead-reckoned samples and every later sample was dropped
+  const Recording& rec = urban();
+  constexpr std::int64_t kJumpNs = 10'000LL * kNsPerSecond;
+  const std::size_t bad = rec.imu.size() / 2;
+  const OnlineRun run = online_run(rec, [&](OnlineOdometry& online) {
+    push_in_order(online, rec, [&](OnlineOdometry& o, std::size_t i) {
+      o.add_imu(rec.imu[i]);
+      if (i != bad) return;
+      ImuSample future = rec.imu[i];
+      future.stamp_ns += kJumpNs;
+      o.add_imu(future);
+    });
+  });
+  EXPECT_TRUE(contains(run.warnings, "jumps by 10000.000 s")) << joined(run.warnings);
+  EXPECT_TRUE(contains(run.warnings, "jumps by -9999.990 s")) << joined(run.warnings);
+  expect_increasing(run.outputs);
+  ASSERT_FALSE(run.outputs.empty());
+  EXPECT_LT(run.outputs.back().stamp_ns, rec.imu.back().stamp_ns + kNsPerSecond);  // nothing at the future stamp
+  EXPECT_GT(run.outputs.back().stamp_ns, rec.imu[bad].stamp_ns + 300'000'000);     // the later samples are used
+  EXPECT_LT(run.outputs.size(), rec.imu.size());
+  for (const auto& s : run.outputs) EXPECT_LT(s.body_pose.translation().norm(), 100.0);
+}
+
+TEST(OnlineClocks, AFarFutureStampBeforeInitialisationDoesNotBlock) {
+  // before: +1e17 ns before the first scan blocked add_imu for 42 s, then dropped every sample
+  const Recording& rec = urban();
+  const OnlineRun run = online_run(rec, [&](OnlineOdometry& online) {
+    push_in_order(online, rec, [&](OnlineOdometry& o, std::size_t i) {
+      o.add_imu(rec.imu[i]);
+      if (i != 3) return;
+      ImuSample future = rec.imu[i];
+      future.stamp_ns += 100'000'000'000'000'000;
+      o.add_imu(future);
+    });
+  });
+  EXPECT_TRUE(contains(run.warnings, "the fusion is reset")) << joined(run.warnings);
+  EXPECT_TRUE(run.inertial);
+  EXPECT_GT(run.outputs.size(), 50u);
+  expect_increasing(run.outputs);
+}
+
+TEST(OnlineClocks, OutOfOrderImuNeverRepeatsAnOutputStamp) {
+  // before: blocks of samples pushed newest first emitted one stamp four times
+  const Recording& rec = urban();
+  constexpr std::size_t kBlock = 7;
+  const OnlineRun run = online_run(rec, [&](OnlineOdometry& online) {
+    std::size_t next = 0;
+    for (const Scan& scan : rec.scans) {
+      while (next < rec.imu.size() && rec.imu[next].stamp_ns <= scan.end_stamp_ns) {
+        const std::size_t end = std::min(next + kBlock, rec.imu.size());
+        for (std::size_t i = end; i > next; --i) online.add_imu(rec.imu[i - 1]);
+        next = end;
+      }
+      push_scan(online, scan);
+    }
+  });
+  ASSERT_GT(run.outputs.size(), 10u);
+  expect_increasing(run.outputs);
+}
+
+TEST(OnlineClocks, AScanBeforeTheFirstImuSampleDoesNotMakeTheRunLidarOnly) {
+  // before: the first scan fixed the mode; without IMU yet the whole run was LiDAR-only
+  const Recording& rec = urban();
+  const OnlineRun run = online_run(rec, [&](OnlineOdometry& online) {
+    push_scan(online, rec.scans.front());  // no IMU sample yet
+    std::size_t next = 0;
+    for (std::size_t k = 1; k < rec.scans.size(); ++k) {
+      while (next < rec.imu.size() && rec.imu[next].stamp_ns <= rec.scans[k].end_stamp_ns) {
+        online.add_imu(rec.imu[next++]);
+      }
+      push_scan(online, rec.scans[k]);
+    }
+  });
+  EXPECT_TRUE(run.inertial);
+  ASSERT_EQ(run.frames.size(), rec.scans.size());
+  EXPECT_FALSE(run.frames.front().fused);
+  EXPECT_TRUE(run.frames.back().fused);
+  EXPECT_GT(run.outputs.size(), 50u);
+  expect_increasing(run.outputs);
+}
+
+TEST(OnlineClocks, AResultFarBehindTheImuClockDoesNotInitialiseTheFilter) {
+  // the IMU 5 s ahead of the scans: the filter would step 500 times (1.7e11 for clocks in
+  // different units) from the scan to the IMU's clock
+  const Recording& rec = urban();
+  const OnlineRun run = online_run(rec, [&](OnlineOdometry& online) {
+    for (const auto& s : rec.imu) {
+      ImuSample ahead = s;
+      ahead.stamp_ns += 5 * kNsPerSecond;
+      online.add_imu(ahead);
+    }
+    push_scan(online, rec.scans[0]);
+    push_scan(online, rec.scans[1]);
+  });
+  ASSERT_EQ(run.frames.size(), 2u);
+  EXPECT_FALSE(run.frames[1].fused);
+  EXPECT_NE(run.frames[1].drop_reason.find("beyond fusion.max_bridged_gap_s"), std::string::npos)
+      << run.frames[1].drop_reason;
+  EXPECT_TRUE(run.outputs.empty() || run.outputs.size() < 10u);
+}
