@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Runs every test of farlio: the style check (clang-format, ruff), the C++ tests (ctest), the
 # same C++ tests under AddressSanitizer + UndefinedBehaviorSanitizer, and the Python tests
-# (pytest) against the installed package, and the ROS 2 node over loopback (tests/ros2, in
+# (pytest) against the installed package, a 5 s fuzz smoke of every file reader (scripts/fuzz.sh),
+# and the ROS 2 node over loopback (tests/ros2, in
 # .venv-ros from scripts/install_ros2.sh; skipped without it). The
 # GPU tests are built and skip without a GPU; scripts/gpu_check.sh runs them on one.
 # Expects scripts/install_deps.sh to have run. Tests that need ../shared/data or a GPU skip
@@ -33,6 +34,11 @@ if [ -x .venv-ros/bin/python ] && .venv-ros/bin/python -c "import rclpy" 2>/dev/
   .venv-ros/bin/python -m pytest -q -p no:warnings tests/ros2
 else
   echo "skipped: no .venv-ros with rclpy (scripts/install_ros2.sh could not install the ROS 2 wheels)"
+fi
+
+if [ "${FARLIO_SKIP_FUZZ:-0}" != 1 ]; then
+  echo "== Fuzz smoke of the file readers (scripts/fuzz.sh, 5 s a target) =="
+  FUZZ_SECONDS=5 bash scripts/fuzz.sh
 fi
 
 if [ "${FARLIO_SKIP_SANITIZERS:-0}" != 1 ]; then
