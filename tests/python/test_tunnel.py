@@ -21,7 +21,9 @@ MIN_DEGENERATE_FRAMES = 150
 
 def _run(seq, out, fused: bool) -> dict:
     config = load_config(None, [] if fused else ["fusion.enabled=false"])
-    return run_dataset(open_dataset(seq), out, config, progress=False, plot=False, options=replay_options("fixed", 0.02))
+    return run_dataset(
+        open_dataset(seq), out, config, progress=False, plot=False, options=replay_options("fixed", 0.02)
+    )
 
 
 @pytest.fixture(scope="module")

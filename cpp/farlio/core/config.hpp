@@ -189,7 +189,7 @@ inline constexpr double kMaxThreads = 1024.0;
         "gyro bias random walk density")                                                                              \
   FIELD(double, accel_bias_walk_m_s3_sqrt_hz, 2e-3, range::non_negative_up_to(kMaxSiValue),                           \
         "accelerometer bias random walk density")                                                                     \
-  FIELD(double, imu_max_accel_m_s2, 160.0, range::positive_up_to(kMaxSiValue),                                       \
+  FIELD(double, imu_max_accel_m_s2, 160.0, range::positive_up_to(kMaxSiValue),                                        \
         "an IMU sample with |accel| over this is impossible and rejected (16 g: MEMS full scale)")                    \
   FIELD(double, imu_max_gyro_rad_s, 35.0, range::positive_up_to(kMaxSiValue),                                         \
         "an IMU sample with |gyro| over this is impossible and rejected (2000 deg/s: MEMS full scale)")               \

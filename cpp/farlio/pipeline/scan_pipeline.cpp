@@ -107,9 +107,9 @@ FrameResult ScanPipeline::process(const Scan& scan, const std::optional<SE3>& in
     // (racetrack launch seed 2: APE 0.16 -> 1.12 m when held there).
     RegistrationConfig reg = config_.registration;
     reg.hold_degenerate_directions = reg.hold_degenerate_directions && initial_guess.has_value();
-    out.registration = backend_->register_source(out.initial_guess,
-                                                 registration::Thresholds::from_sigma(out.sigma_m, p2p), reg,
-                                                 config_.registration.time_budget_factor * period_s);
+    out.registration =
+        backend_->register_source(out.initial_guess, registration::Thresholds::from_sigma(out.sigma_m, p2p), reg,
+                                  config_.registration.time_budget_factor * period_s);
     out.registered = true;
     out.failure = registration::failure_reason(out.registration, source.points, config_.registration);
     if (out.failure.empty()) {
