@@ -66,7 +66,6 @@ std::string drop_reason(const FrameResult& result, bool map_started) {
     return result.map_restarted ? result.failure + "; the map restarted from this scan" : result.failure;
   }
   if (!result.registered && map_started) return "nothing to register against";
-  if (result.registration.budget_exceeded) return "registration exceeded its time budget";
   return {};
 }
 
