@@ -42,13 +42,6 @@ const Recording& handheld() {  // 50 scans through rooms: the sensor turns from 
   return r;
 }
 
-/// Decides the gyro's unit after 0.15 rad (the handheld's first turn) instead of the default.
-Config quick_gyro_unit_config() {
-  Config c = deterministic_config();
-  c.fusion.gyro_unit_min_rotation_rad = 0.15;
-  return c;
-}
-
 bool contains(const std::vector<std::string>& warnings, const std::string& fragment) {
   return std::any_of(warnings.begin(), warnings.end(),
                      [&](const std::string& w) { return w.find(fragment) != std::string::npos; });
@@ -325,8 +318,8 @@ TEST(ReplayClocks, AGyroInDegreesPerSecondIsScaled) {
   const Recording& rec = handheld();
   std::vector<ImuSample> deg = rec.imu;
   for (auto& s : deg) s.gyro_rad_s *= kDegPerRad;
-  const ReplayRun normal = replay(rec, rec.imu, nullptr, quick_gyro_unit_config());
-  const ReplayRun run = replay(rec, deg, nullptr, quick_gyro_unit_config());
+  const ReplayRun normal = replay(rec, rec.imu);
+  const ReplayRun run = replay(rec, deg);
   EXPECT_TRUE(contains(run.warnings, "the gyro reports in deg/s")) << joined(run.warnings);
   EXPECT_FALSE(contains(normal.warnings, "the gyro")) << joined(normal.warnings);
   EXPECT_TRUE(run.inertial_at_end);
@@ -339,7 +332,7 @@ TEST(ReplayClocks, AStuckGyroEndsTheFusion) {
   const Recording& rec = handheld();
   std::vector<ImuSample> stuck = rec.imu;
   for (auto& s : stuck) s.gyro_rad_s = Eigen::Vector3d(0.002, -0.001, 0.0);
-  const ReplayRun run = replay(rec, stuck, nullptr, quick_gyro_unit_config());
+  const ReplayRun run = replay(rec, stuck);
   EXPECT_TRUE(contains(run.warnings, "the gyro is stuck")) << joined(run.warnings);
   EXPECT_FALSE(run.inertial_at_end);
   for (const auto& f : run.frames) EXPECT_TRUE(f.body_pose.translation().allFinite());

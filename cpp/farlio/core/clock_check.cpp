@@ -1,20 +1,12 @@
 #include "farlio/core/clock_check.hpp"
 
 #include <array>
-#include <cstdio>
 #include <utility>
 
 #include "farlio/core/time.hpp"
 
 namespace farlio {
 namespace {
-
-/// Seconds with millisecond resolution ("1700000000.100").
-std::string seconds_text(double s) {
-  std::array<char, 64> buf{};
-  std::snprintf(buf.data(), buf.size(), "%.3f", s);
-  return buf.data();
-}
 
 struct Span {
   double first_s, last_s;

@@ -249,7 +249,7 @@ inline constexpr double kMaxThreads = 1024.0;
   FIELD(bool, gyro_unit_detection, true, range::unchecked(),                                                          \
         "detect a gyro reporting in deg/s (its rotation ~57x the LiDAR's) and scale it; a gyro that stays "           \
         "constant while the LiDAR turns is not used")                                                                 \
-  FIELD(double, gyro_unit_min_rotation_rad, 0.3, range::positive_up_to(kMaxSiValue),                                  \
+  FIELD(double, gyro_unit_min_rotation_rad, 0.1, range::positive_up_to(kMaxSiValue),                                  \
         "the gyro unit is decided once the gyro's or the LiDAR's rotation over the scans reaches this; until then "   \
         "a scan during which the gyro turns is registered without the fusion's guess")
 

@@ -3,6 +3,8 @@
 // converts between them.
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <string>
 
 namespace farlio {
 
@@ -14,5 +16,13 @@ inline std::int64_t seconds_to_ns(double seconds) { return static_cast<std::int6
 
 /// Nanoseconds (a stamp difference) to seconds.
 inline double ns_to_seconds(std::int64_t ns) { return static_cast<double>(ns) / kNsPerS; }
+
+/// Seconds with millisecond resolution ("1700000000.100"), for messages.
+inline std::string seconds_text(double seconds) {
+  constexpr std::size_t kChars = 64;
+  char buf[kChars];
+  std::snprintf(buf, kChars, "%.3f", seconds);
+  return buf;
+}
 
 }  // namespace farlio

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 
 #include "farlio/core/config_fields.hpp"
@@ -15,14 +14,8 @@ namespace {
 
 // Poses sampled over a scan for the motion regression.
 constexpr int kMotionSamples = 11;
-/// Warnings kept between two take_warnings calls; later ones are counted, not kept.
+/// Warnings kept between two take_warnings calls; later ones are left out (a last one says so).
 constexpr std::size_t kMaxPendingWarnings = 100;
-
-std::string seconds_text(double s) {
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), "%.3f", s);
-  return buf;
-}
 
 std::optional<deskew::ScanMotion> motion_from_fusion(const fusion::SensorFusion& fusion, const Scan& scan,
                                                      const SE3& end_pose, const SE3& T_imu_lidar) {
@@ -109,7 +102,6 @@ ImuSample FusionDriver::in_si_units(const ImuSample& sample) const {
 
 void FusionDriver::restart_fusion(const std::deque<ImuSample>& samples, bool regrid) {
   fusion_.emplace(fusion_config_, gravity_m_s2_);
-  ++fusion_restarts_;
   if (regrid) {
     next_output_ns_ = 0;
     last_output_ns_.reset();
@@ -204,7 +196,7 @@ ScanPrior FusionDriver::prior(const Scan& scan) const {
   ScanPrior prior;
   if (!fusion_ || !fusion_->initialized()) return prior;
   // while the gyro's unit is undecided, a scan during which it turns is registered by the LiDAR
-  // alone: a deg/s gyro would turn the guess 57 times too far
+  // alone: a deg/s gyro would turn the guess 57 times too far (and the registration would follow)
   if (gyro_unit_.turning(scan.start_stamp_ns, scan.end_stamp_ns)) return prior;
   if (const auto body = fusion_->pose_at(scan.end_stamp_ns)) {
     prior.guess = *body * T_imu_lidar_;

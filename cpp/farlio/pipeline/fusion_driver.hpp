@@ -80,8 +80,6 @@ class FusionDriver {
   [[nodiscard]] std::vector<std::string> take_warnings() { return std::exchange(warnings_, {}); }
   /// fusion.max_bridged_gap_s: the largest jump of the IMU clock the fusion bridges.
   [[nodiscard]] double max_bridged_gap_s() const { return fusion_config_.max_bridged_gap_s; }
-  /// How often the fusion was started again (a clock jump, a gyro in deg/s).
-  [[nodiscard]] int fusion_restarts() const { return fusion_restarts_; }
 
   [[nodiscard]] bool inertial() const { return fusion_.has_value(); }
   /// Whether an IMU sample has been fed.
@@ -133,7 +131,6 @@ class FusionDriver {
   std::optional<StampedPose> last_body_;  ///< the previous processed scan's body pose
   std::optional<Mat6d> last_covariance_;  ///< and its registration covariance
   std::vector<std::string> warnings_;
-  int fusion_restarts_ = 0;
 };
 
 }  // namespace farlio::pipeline
