@@ -16,6 +16,7 @@
 #include "farlio/core/config_fields.hpp"
 #include "farlio/pipeline/odometry.hpp"
 #include "farlio/pipeline/online_odometry.hpp"
+#include "farlio/pipeline/map_export.hpp"
 #include "farlio/pipeline/pairwise.hpp"
 #include "farlio/pipeline/scan_pipeline.hpp"
 #include "repr.hpp"
@@ -189,6 +190,11 @@ void bind_pipeline(nb::module_& m) {
               "why the registration's pose was not used (empty: it was); the scan kept the prediction")
       .def_ro("map_restarted", &pipeline::FrameResult::map_restarted,
               "the map restarted from this scan after registration failures (recovery)")
+      .def_ro("inlier_fraction", &pipeline::FrameResult::inlier_fraction,
+              "inliers over source points of the registration (0 when not registered)")
+      .def_ro("lost", &pipeline::FrameResult::lost,
+              "localization in a prior map: the scan did not match the map (its pose is the prediction)")
+      .def_ro("undistorted", &pipeline::FrameResult::undistorted, "whether the scan was undistorted")
       .def_prop_ro("converged", [](const pipeline::FrameResult& r) { return r.registration.converged; })
       .def_prop_ro("iterations", [](const pipeline::FrameResult& r) { return r.registration.iterations; })
       .def_prop_ro("inliers", [](const pipeline::FrameResult& r) { return r.registration.system.inliers; })
@@ -315,6 +321,17 @@ void bind_pipeline(nb::module_& m) {
             return out;
           },
           "[(stamp_ns, body pose)] of the 10 ms odometry output since the last call.")
+      .def(
+          "set_initial_pose", [](PyOdometry& o, const SE3& pose) { o.odometry.set_initial_pose(pose); },
+          "body_pose"_a,
+          "The body pose at the first scan in the world (the prior map's frame): position and yaw as given; roll "
+          "and pitch too when LiDAR-only, from gravity when inertial. Before the first scan.")
+      .def(
+          "set_prior_map", [](PyOdometry& o, const Scan& map) { o.odometry.set_prior_map(map.points); }, "map"_a,
+          "Localization: the submap is built from the points of `map` (world frame) and held fixed. Before the "
+          "first scan.")
+      .def_prop_ro("localizing",
+                   [](const PyOdometry& o) { return o.odometry.scan_pipeline().localizing(); })
       .def_prop_ro("inertial", [](const PyOdometry& o) { return o.odometry.inertial(); })
       .def(
           "take_warnings", [](PyOdometry& o) { return o.odometry.take_warnings(); },
@@ -336,6 +353,33 @@ void bind_pipeline(nb::module_& m) {
       .def_prop_ro(
           "device_message", [](const PyOdometry& o) { return o.odometry.scan_pipeline().device_message(); },
           "why device auto fell back to the CPU ('' when it did not)");
+
+  m.def("export_resolution_m", &pipeline::export_resolution_m, "config"_a,
+        "map.export_resolution_m, or the map's point spacing when 0 (after the first scan fixed the voxel size, "
+        "pass the effective config)");
+  nb::class_<pipeline::MapExport>(m, "MapExport",
+                                  "The whole map of a run: every used scan, undistorted, at its pose, one centroid "
+                                  "(with the mean intensity) per cell of resolution_m; memory grows with the mapped "
+                                  "volume, not the run's length.")
+      .def(
+          "__init__",
+          [](pipeline::MapExport* self, double resolution_m, const Config& config) {
+            new (self) pipeline::MapExport(resolution_m, config.preprocess);
+          },
+          "resolution_m"_a, "config"_a)
+      .def(
+          "add",
+          [](pipeline::MapExport& e, const Scan& scan, const pipeline::FrameResult& r) {
+            return e.add(scan, r.motion, r.undistorted, r.pose);
+          },
+          "scan"_a, "result"_a, nb::call_guard<nb::gil_scoped_release>(),
+          "Adds a processed scan at its pose with the motion it was undistorted with; returns the points added.")
+      .def("points", &pipeline::MapExport::points, nb::call_guard<nb::gil_scoped_release>(),
+           "The map as a Scan: one point per cell (centroid, mean intensity), ordered by cell.")
+      .def_prop_ro("cells", &pipeline::MapExport::cells)
+      .def_prop_ro("points_added", &pipeline::MapExport::points_added)
+      .def_prop_ro("resolution_m", &pipeline::MapExport::resolution_m)
+      .def_prop_ro("memory_bytes", &pipeline::MapExport::memory_bytes);
 
   nb::class_<pipeline::OdometrySample>(m, "OdometrySample", "One 10 ms sample of the fused odometry.")
       .def_ro("stamp_ns", &pipeline::OdometrySample::stamp_ns)

@@ -116,6 +116,17 @@ void bind_sim(nb::module_& m) {
       .def("motion_compensated", &SequenceGenerator::motion_compensated, "scan"_a,
            nb::call_guard<nb::gil_scoped_release>(),
            "The scan as KITTI stores its scans: in the LiDAR frame at the scan end, no per-point times.")
+      .def(
+          "surface_distance_m",
+          [](const SequenceGenerator& g, const Eigen::Matrix<double, Eigen::Dynamic, 3>& points) {
+            Eigen::VectorXd out(points.rows());
+            for (Eigen::Index i = 0; i < points.rows(); ++i) {
+              out(i) = g.scene().surface_distance_m(points.row(i).transpose());
+            }
+            return out;
+          },
+          "points"_a, nb::call_guard<nb::gil_scoped_release>(),
+          "Distance of each world point ((N, 3)) to the nearest surface of the scene (brute force: for tests).")
       .def("imu", &SequenceGenerator::imu, nb::call_guard<nb::gil_scoped_release>(),
            "All IMU samples over the duration as a list of ImuSample.")
       .def(

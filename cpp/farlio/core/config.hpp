@@ -78,6 +78,8 @@ inline constexpr double kMaxThreads = 1024.0;
   FIELD(bool, refresh_covariances, true, range::unchecked(),                                           \
         "recompute the covariances of existing points in voxels that receive new points "              \
         "(the reference never refreshes them)")                                                        \
+  FIELD(double, export_resolution_m, 0.0, range::non_negative_up_to(kMaxVoxelSize_m),                  \
+        "cell of the whole map farlio run --save-map writes (one centroid a cell); 0: the point spacing") \
   FIELD(std::int64_t, initial_voxel_capacity, 1 << 14, range::between(1, kMaxVoxelCapacity),           \
         "voxels preallocated; the pool doubles as needed")                                             \
   FIELD(std::int64_t, max_voxel_capacity, 1 << 20, range::between(1, kMaxVoxelCapacity),               \
@@ -264,6 +266,12 @@ inline constexpr double kMaxThreads = 1024.0;
         "device buffers: voxels of the per-scan frame map")
 
 // ---- top level ---------------------------------------------------------------------------------
+// ---- localization: odometry in a prior map held fixed (farlio run --prior-map) -------------------
+#define FARLIO_LOCALIZATION_FIELDS(FIELD)                                                                       \
+  FIELD(double, min_inlier_fraction, 0.8, range::fraction(),                                                    \
+        "a scan registered in the prior map that matches fewer of its source points is lost (timing.csv): the " \
+        "map is fixed, so a scan of the mapped scene matches most of its points; its pose is not used")
+
 #define FARLIO_TOP_FIELDS(FIELD)                                                           \
   FIELD(Device, device, Device::Auto, range::unchecked(),                                  \
         "scan pipeline backend: auto (CUDA when a GPU is present, else CPU), cpu or cuda") \
@@ -289,6 +297,9 @@ struct RegistrationConfig {
 struct FusionConfig {
   FARLIO_FUSION_FIELDS(FARLIO_CONFIG_MEMBER)
 };
+struct LocalizationConfig {
+  FARLIO_LOCALIZATION_FIELDS(FARLIO_CONFIG_MEMBER)
+};
 struct CudaConfig {
   FARLIO_CUDA_FIELDS(FARLIO_CONFIG_MEMBER)
 };
@@ -300,6 +311,7 @@ struct Config {
   ThresholdConfig threshold;
   RegistrationConfig registration;
   FusionConfig fusion;
+  LocalizationConfig localization;
   CudaConfig cuda;
   FARLIO_TOP_FIELDS(FARLIO_CONFIG_MEMBER)
 };

@@ -148,6 +148,15 @@ class CudaScanBackend final : public pipeline::ScanBackend {
     return stats;
   }
 
+  /// In pieces of the scan buffers' size, in input order (as the CPU backend's one insert).
+  void load_map(const std::vector<Eigen::Vector3f>& world_points) override {
+    const map::PointLimit limit = map::PointLimit::constant(config_.map.max_points_per_voxel);
+    for (std::size_t first = 0; first < world_points.size(); first += max_points_) {
+      const std::size_t n = std::min(max_points_, world_points.size() - first);
+      world_.upload(world_points.data() + first, n, executor_.stream(), kScanParameter);
+      map_.insert(world_.data(), n, Eigen::Vector3f::Zero(), limit);
+    }
+  }
   [[nodiscard]] std::size_t map_voxels() const override { return map_.num_voxels(); }
   [[nodiscard]] std::size_t map_points() const override { return map_.num_points(); }
   [[nodiscard]] map::MapSnapshot map_snapshot() const override { return map_.snapshot(); }

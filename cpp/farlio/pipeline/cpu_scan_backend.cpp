@@ -58,4 +58,8 @@ map::InsertStats CpuScanBackend::update_map(const SE3& pose, const map::PointLim
   return stats;
 }
 
+void CpuScanBackend::load_map(const std::vector<Eigen::Vector3f>& world_points) {
+  map_.insert(world_points, Eigen::Vector3f::Zero(), map::PointLimit::constant(config_.map.max_points_per_voxel));
+}
+
 }  // namespace farlio::pipeline

@@ -20,6 +20,7 @@ class CpuScanBackend final : public ScanBackend {
   registration::RegistrationResult register_source(const SE3& initial_guess, const registration::Thresholds& th,
                                                    const RegistrationConfig& config, double time_budget_s) override;
   map::InsertStats update_map(const SE3& pose, const map::PointLimit& limit, std::size_t* removed_voxels) override;
+  void load_map(const std::vector<Eigen::Vector3f>& world_points) override;
   [[nodiscard]] std::size_t map_voxels() const override { return map_.num_voxels(); }
   [[nodiscard]] std::size_t map_points() const override { return map_.num_points(); }
   [[nodiscard]] std::size_t memory_bytes() const override { return map_.memory_bytes(); }

@@ -6,6 +6,7 @@
 #include "farlio/core/clock_check.hpp"
 #include "farlio/core/error.hpp"
 #include "farlio/core/time.hpp"
+#include "farlio/fusion/euler.hpp"
 #include "farlio/fusion/gyro_unit_detector.hpp"
 
 namespace farlio::pipeline {
@@ -63,6 +64,11 @@ Odometry::Odometry(const Config& config, const SE3& T_imu_lidar, double gravity_
   }
 }
 
+void Odometry::set_initial_pose(const SE3& body_pose) {
+  if (pipeline_.frames() > 0) throw std::logic_error("Odometry::set_initial_pose after the first scan");
+  requested_initial_pose_ = body_pose;
+}
+
 std::vector<std::string> Odometry::take_warnings() {
   std::vector<std::string> out = std::exchange(warnings_, {});
   for (std::string& w : driver_.take_warnings()) out.push_back(std::move(w));
@@ -118,8 +124,16 @@ OdometryFrame Odometry::process(const Scan& scan) {
   OdometryFrame out;
   out.started_ns = std::max(scan.end_stamp_ns, clock_ns_);
   advance_clock(out.started_ns);
-  if (pipeline_.frames() == 0 && driver_.inertial()) {  // roll and pitch from the IMU seen so far
-    initial_body_pose_ = driver_.start_pose(scan.end_stamp_ns);
+  if (pipeline_.frames() == 0 && (driver_.inertial() || requested_initial_pose_)) {
+    // roll and pitch from the IMU seen so far; position and yaw as requested
+    initial_body_pose_ = driver_.inertial() ? driver_.start_pose(scan.end_stamp_ns) : SE3();
+    if (requested_initial_pose_ && driver_.inertial()) {
+      Eigen::Vector3d rpy = fusion::euler_from_rotation(initial_body_pose_.rotation());
+      rpy.z() = fusion::euler_from_rotation(requested_initial_pose_->rotation()).z();
+      initial_body_pose_ = SE3(Eigen::Quaterniond(fusion::rotation_from_euler(rpy)), requested_initial_pose_->translation());
+    } else if (requested_initial_pose_) {
+      initial_body_pose_ = *requested_initial_pose_;
+    }
     pipeline_.reset_initial_pose(initial_body_pose_ * T_imu_lidar_);
   }
 

@@ -48,6 +48,15 @@ class Odometry {
   Odometry(const Config& config, const SE3& T_imu_lidar, double gravity_m_s2, std::vector<ImuSample> imu,
            const ReplayOptions& options = {});
 
+  /// The body pose at the first scan in the world frame (default: the origin, yaw 0). Position
+  /// and yaw are taken as given; roll and pitch too when LiDAR-only, while an inertial run takes
+  /// them from gravity (the IMU measures them, as at the start of every run). Before the first
+  /// scan only (throws std::logic_error after).
+  void set_initial_pose(const SE3& body_pose);
+  /// Localization in a prior map whose frame is the world frame (ScanPipeline::set_prior_map):
+  /// pair with set_initial_pose where the run does not start where the mapping run started.
+  void set_prior_map(std::vector<Eigen::Vector3f> world_points) { pipeline_.set_prior_map(std::move(world_points)); }
+
   /// Processes the next scan (scans must come in time order).
   OdometryFrame process(const Scan& scan);
   /// Advances the clock to stamp_ns (e.g. the end of the recording), emitting odometry.
@@ -72,6 +81,7 @@ class Odometry {
   ReplayOptions options_;
   SE3 T_imu_lidar_, T_lidar_imu_;
   SE3 initial_body_pose_;
+  std::optional<SE3> requested_initial_pose_;  ///< set_initial_pose
   std::vector<ImuSample> imu_;
   std::size_t next_imu_ = 0;
   FusionDriver driver_;

@@ -45,6 +45,9 @@ class ScanBackend {
                                                            const RegistrationConfig& config, double time_budget_s) = 0;
   /// Inserts the frame at `pose` into the submap, then removes voxels far from the pose.
   virtual map::InsertStats update_map(const SE3& pose, const map::PointLimit& limit, std::size_t* removed_voxels) = 0;
+  /// Inserts world-frame points into the submap with the full per-voxel limit and removes
+  /// nothing (a prior map for localization; after reset, before the first scan's registration).
+  virtual void load_map(const std::vector<Eigen::Vector3f>& world_points) = 0;
   [[nodiscard]] virtual std::size_t map_voxels() const = 0;
   [[nodiscard]] virtual std::size_t map_points() const = 0;
   /// Bytes held for the submap (CPU) or all device buffers (CUDA, preallocated).

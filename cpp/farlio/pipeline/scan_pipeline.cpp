@@ -33,6 +33,12 @@ void ScanPipeline::reset_initial_pose(const SE3& initial_pose) {
   initial_pose_ = last_pose_ = prev_pose_ = initial_pose;
 }
 
+void ScanPipeline::set_prior_map(std::vector<Eigen::Vector3f> world_points) {
+  if (frames_ > 0) throw std::logic_error("ScanPipeline::set_prior_map after the first scan");
+  prior_map_ = std::move(world_points);
+  prior_map_loaded_ = false;
+}
+
 registration::Vec6d ScanPipeline::last_twist() const {
   if (frames_ < 2 || last_stamp_ns_ <= prev_stamp_ns_) return registration::Vec6d::Zero();
   const double dt = ns_to_seconds(last_stamp_ns_ - prev_stamp_ns_);
@@ -62,6 +68,10 @@ FrameResult ScanPipeline::process(const Scan& scan, const std::optional<SE3>& in
     }
     config_.map.auto_voxel_size = false;  // the effective config states the size used
   }
+  if (prior_map_ && !prior_map_loaded_ && scale_fixed_) {  // localization: the map at the scale fixed
+    backend_->load_map(*prior_map_);
+    prior_map_loaded_ = true;
+  }
 
   // 1. preprocess: crop, undistort into the scan-end frame, downsample to the map spacing
   auto t0 = Clock::now();
@@ -69,6 +79,8 @@ FrameResult ScanPipeline::process(const Scan& scan, const std::optional<SE3>& in
       motion ? *motion
              : deskew::ScanMotion::constant_twist(last_twist().cast<float>(), static_cast<float>(scan.duration_s()));
   const bool undistort = config_.preprocess.undistort && scan.has_time() && !scan_motion.is_identity();
+  out.motion = scan_motion;
+  out.undistorted = undistort;
   out.kept_points = backend_->preprocess(scan, scan_motion, undistort);
   out.timings.preprocess_s = seconds_since(t0);
 
@@ -111,7 +123,12 @@ FrameResult ScanPipeline::process(const Scan& scan, const std::optional<SE3>& in
         backend_->register_source(out.initial_guess, registration::Thresholds::from_sigma(out.sigma_m, p2p), reg,
                                   config_.registration.time_budget_factor * period_s);
     out.registered = true;
+    out.inlier_fraction = static_cast<double>(out.registration.system.inliers) / static_cast<double>(source.points);
     out.failure = registration::failure_reason(out.registration, source.points, config_.registration);
+    if (out.failure.empty() && localizing() && out.inlier_fraction < config_.localization.min_inlier_fraction) {
+      out.failure = "not localized: " + std::to_string(static_cast<int>(100.0 * out.inlier_fraction)) +
+                    " % of the points match the prior map (localization.min_inlier_fraction)";
+    }
     if (out.failure.empty()) {
       pose = out.registration.pose;
       threshold_.update(out.initial_guess.inverse() * pose);
@@ -120,13 +137,17 @@ FrameResult ScanPipeline::process(const Scan& scan, const std::optional<SE3>& in
     out.failure = "nothing to register against (no points after preprocessing)";
   }
   out.pose = pose;
+  out.lost = localizing() && !out.failure.empty();
   out.timings.registration_s = seconds_since(t0);
 
   // 4. submap update with the adaptive density, then removal of far voxels. A failed scan
   // changes nothing, unless failures have lasted map_restart_after_s: then the map restarts
-  // from this scan at the prediction (recovery when the old map no longer matches).
+  // from this scan at the prediction (recovery when the old map no longer matches). A prior
+  // map (localization) is held fixed.
   t0 = Clock::now();
-  if (out.failure.empty()) {
+  if (localizing()) {
+    // nothing changes the map
+  } else if (out.failure.empty()) {
     failing_since_ns_.reset();
   } else {
     if (!failing_since_ns_) failing_since_ns_ = scan.end_stamp_ns;
@@ -137,7 +158,7 @@ FrameResult ScanPipeline::process(const Scan& scan, const std::optional<SE3>& in
       failing_since_ns_.reset();
     }
   }
-  if (out.failure.empty() || out.map_restarted) out.map_insert = backend_->update_map(pose, limit, &out.removed_voxels);
+  if (!localizing() && (out.failure.empty() || out.map_restarted)) out.map_insert = backend_->update_map(pose, limit, &out.removed_voxels);
   out.map_voxels = backend_->map_voxels();
   out.map_points = backend_->map_points();
   out.timings.map_update_s = seconds_since(t0);

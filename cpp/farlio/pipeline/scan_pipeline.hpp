@@ -13,6 +13,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "farlio/core/config.hpp"
 #include "farlio/core/se3.hpp"
@@ -38,6 +39,13 @@ struct FrameResult {
   /// non-finite pose. The scan then keeps the predicted pose and changes no state.
   std::string failure;
   bool map_restarted = false;  ///< the map was restarted from this scan (after failures, recovery)
+  /// Inliers over source points of the registration (0 when not registered).
+  double inlier_fraction = 0;
+  /// Localization in a prior map: the scan did not match the map (a failure, or an inlier
+  /// fraction below localization.min_inlier_fraction); its pose is the prediction.
+  bool lost = false;
+  deskew::ScanMotion motion;  ///< the motion the scan was undistorted with
+  bool undistorted = false;   ///< whether it was (per-point times, preprocess.undistort, motion)
   double sigma_m = 0;          ///< adaptive threshold used
   int density_limit = 0;       ///< close-range per-voxel limit chosen by ASMD
   std::size_t input_points = 0, kept_points = 0, source_points = 0;
@@ -66,6 +74,13 @@ class ScanPipeline {
   /// Replaces the initial pose; only before the first scan (throws std::logic_error after).
   void reset_initial_pose(const SE3& initial_pose);
 
+  /// Localization: the submap is built from `world_points` (a prior map, in the world frame of
+  /// the poses) at the first scan, once the voxel size is fixed, and then held fixed: scans are
+  /// registered against it and never inserted, nothing is removed, failures do not restart it.
+  /// Only before the first scan (throws std::logic_error after).
+  void set_prior_map(std::vector<Eigen::Vector3f> world_points);
+  [[nodiscard]] bool localizing() const { return prior_map_.has_value(); }
+
   /// The backend that runs the stages (its submap, memory and device).
   [[nodiscard]] const ScanBackend& backend() const { return *backend_; }
   [[nodiscard]] ScanBackend& backend() { return *backend_; }
@@ -90,6 +105,8 @@ class ScanPipeline {
   std::size_t frames_ = 0;
   bool scale_fixed_ = false;
   std::optional<std::int64_t> failing_since_ns_;  ///< scan end of the first failure in a row
+  std::optional<std::vector<Eigen::Vector3f>> prior_map_;  ///< localization: the map held fixed
+  bool prior_map_loaded_ = false;
 };
 
 }  // namespace farlio::pipeline

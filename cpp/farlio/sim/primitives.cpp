@@ -1,5 +1,6 @@
 #include "farlio/sim/primitives.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -78,6 +79,27 @@ std::optional<RayHit> Cylinder::intersect(const Eigen::Vector3d& origin, const E
     }
   }
   return best;
+}
+
+namespace {
+/// Distance to the surface of the region where every component of `excess` (the signed distance
+/// beyond each pair of faces) is <= 0.
+template <typename Vec>
+double surface_distance(const Vec& excess) {
+  const double outside = excess.cwiseMax(0.0).norm();
+  return outside > 0.0 ? outside : -excess.maxCoeff();
+}
+}  // namespace
+
+double Box::surface_distance_m(const Eigen::Vector3d& p) const {
+  const Eigen::Vector3d local = Eigen::AngleAxisd(-yaw_rad, Eigen::Vector3d::UnitZ()) * (p - center_m);
+  return surface_distance(Eigen::Vector3d(local.cwiseAbs() - half_extent_m));
+}
+
+double Cylinder::surface_distance_m(const Eigen::Vector3d& p) const {
+  const double radial = (p.head<2>() - center_m).norm() - radius_m;
+  const double vertical = std::max(z_min_m - p.z(), p.z() - z_max_m);
+  return surface_distance(Eigen::Vector2d(radial, vertical));
 }
 
 Eigen::Vector4d Cylinder::bounds_xy() const {

@@ -25,6 +25,8 @@ struct Box {
                                                 double max_range_m) const;
   /// Horizontal bounding rectangle (min x, min y, max x, max y).
   [[nodiscard]] Eigen::Vector4d bounds_xy() const;
+  /// Distance from p to the box's surface (from inside or outside).
+  [[nodiscard]] double surface_distance_m(const Eigen::Vector3d& p) const;
 };
 
 /// A vertical solid cylinder with flat caps (poles, tree trunks and crowns, pillars).
@@ -38,6 +40,8 @@ struct Cylinder {
   [[nodiscard]] std::optional<RayHit> intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
                                                 double max_range_m) const;
   [[nodiscard]] Eigen::Vector4d bounds_xy() const;
+  /// Distance from p to the cylinder's surface, caps included (from inside or outside).
+  [[nodiscard]] double surface_distance_m(const Eigen::Vector3d& p) const;
 };
 
 /// Ground z = h(x), piecewise linear through knots (constant beyond the ends), infinite in y.

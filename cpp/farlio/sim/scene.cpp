@@ -123,4 +123,12 @@ std::optional<RayHit> Scene::cast(const Eigen::Vector3d& origin, const Eigen::Ve
   return best;
 }
 
+double Scene::surface_distance_m(const Eigen::Vector3d& p) const {
+  double d = std::abs(p.z() - ground_.height_m(p.x()));
+  if (ceiling_) d = std::min(d, std::abs(p.z() - ceiling_->z_m));
+  for (const Box& b : boxes_) d = std::min(d, b.surface_distance_m(p));
+  for (const Cylinder& c : cylinders_) d = std::min(d, c.surface_distance_m(p));
+  return d;
+}
+
 }  // namespace farlio::sim

@@ -25,6 +25,10 @@ class Scene {
   [[nodiscard]] std::optional<RayHit> cast(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
                                            double max_range_m) const;
 
+  /// Distance from p to the nearest surface (ground, ceiling, boxes, cylinders; the ground's
+  /// vertical distance, exact on level ground). Brute force over the primitives: for tests.
+  [[nodiscard]] double surface_distance_m(const Eigen::Vector3d& p) const;
+
   [[nodiscard]] std::size_t num_primitives() const { return boxes_.size() + cylinders_.size(); }
   [[nodiscard]] const std::vector<Box>& boxes() const { return boxes_; }
   [[nodiscard]] const std::vector<Cylinder>& cylinders() const { return cylinders_; }
