@@ -1,6 +1,7 @@
 """Pictures of a run, written into its output folder: trajectory.png (the estimated body path seen
-from above, with the ground truth when there is one) and latency.png (histogram of the per-frame
-processing time with its median and p99)."""
+from above, with the ground truth when there is one), latency.png (histogram of the per-frame
+processing time with its median and p99) and, with --save-map, map.png (the whole map from above,
+coloured by height, with the path on top)."""
 
 from __future__ import annotations
 
@@ -13,6 +14,13 @@ from farlio import _core
 
 TRAJECTORY_PNG = "trajectory.png"
 LATENCY_PNG = "latency.png"
+MAP_PNG = "map.png"
+#: map.png draws at most this many points (an even subsample of a larger map)
+MAP_PNG_MAX_POINTS = 400_000
+#: the colour scale of the height spans these percentiles (a few high points do not wash it out)
+HEIGHT_PERCENTILES = (2, 98)
+MAP_FIGURE_SIZE_IN = (8.0, 8.0)
+MAP_POINT_SIZE = 0.3
 HISTOGRAM_BINS = 40
 FIGURE_SIZE_IN = (6.0, 4.5)
 DPI = 110
@@ -43,6 +51,37 @@ def plot_trajectory(estimate: Path, path: Path, groundtruth: Path | None = None)
     ax.grid(True, alpha=0.3)
     ax.legend()
     ax.set_title(f"trajectory: {Path(estimate).name}")
+    fig.tight_layout()
+    fig.savefig(path, dpi=DPI)
+    plt.close(fig)
+
+
+def plot_map(points: np.ndarray, trajectory: Path, path: Path) -> None:
+    """map.png: the map's points (N, 3, world frame) from above coloured by height, with the
+    trajectory (a TUM file in the same frame) drawn on top."""
+    plt = _pyplot()
+    pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    if len(pts) > MAP_PNG_MAX_POINTS:
+        pts = pts[:: int(np.ceil(len(pts) / MAP_PNG_MAX_POINTS))]
+    fig, ax = plt.subplots(figsize=MAP_FIGURE_SIZE_IN)
+    if len(pts):
+        order = np.argsort(pts[:, 2])  # high points drawn last (roofs over the ground)
+        lo, hi = np.percentile(pts[:, 2], HEIGHT_PERCENTILES)
+        sc = ax.scatter(
+            pts[order, 0], pts[order, 1], c=pts[order, 2], s=MAP_POINT_SIZE, cmap="viridis", vmin=lo, vmax=max(hi, lo + 1e-3),
+            linewidths=0, rasterized=True,
+        )
+        fig.colorbar(sc, ax=ax, shrink=0.7, label="height z [m]")
+    if Path(trajectory).exists():
+        poses = _core.io.read_trajectory(Path(trajectory)).matrices()
+        if len(poses):
+            ax.plot(poses[:, 0, 3], poses[:, 1, 3], "r-", linewidth=1.2, label="trajectory")
+            ax.plot(poses[0, 0, 3], poses[0, 1, 3], "ro", markersize=4)
+            ax.legend(loc="upper right")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_title(f"map: {len(points)} points")
     fig.tight_layout()
     fig.savefig(path, dpi=DPI)
     plt.close(fig)

@@ -11,7 +11,9 @@ Outputs in the output folder (every trajectory file names its frame):
                          written also when the run is interrupted (SIGINT, SIGTERM: "interrupted": true)
   config.yaml            the full effective parameter set
   eval_scans/, eval_odometry/   eval.json + eval.png against the ground truth, when there is one
-  map.ply, map.pcd       the final submap, world frame (with --save-map)
+  map.pcd, map.ply, map.png   the whole map (every scan whose pose was used, one centroid per cell
+                         of the export resolution, with intensity), world frame, and its picture
+                         from above (with --save-map; mapping.py)
   trajectory.png, latency.png   the estimated path (with ground truth) and the latency histogram (with plot)
 """
 
@@ -32,6 +34,7 @@ from farlio import _core
 
 from .config import config_to_yaml
 from .datasets import Dataset
+from .mapping import MapOptions, WholeMap, load_prior_map
 from .progress import Progress
 from .timing_csv import MS_PER_S, TIMING_CSV, TimingCsv
 
@@ -45,7 +48,6 @@ LATENCY_MODELS = {
 CONFIG_YAML, SUMMARY_JSON = "config.yaml", "summary.json"
 SCANS_LIDAR_TUM, SCANS_BODY_TUM, ODOMETRY_TUM = "scans_lidar.tum", "scans_body.tum", "odometry_body.tum"
 SCANS_LIDAR_KITTI = "scans_lidar_kitti.txt"
-MAP_PLY, MAP_PCD = "map.ply", "map.pcd"
 EVAL_SCANS_DIR, EVAL_ODOMETRY_DIR = "eval_scans", "eval_odometry"
 MEDIAN_PERCENTILE, TAIL_PERCENTILE = 50, 99
 #: fewer registered poses than this are not evaluated
@@ -79,6 +81,7 @@ def run_dataset(
     *,
     max_frames: int | None = None,
     save_map: bool = False,
+    maps: MapOptions | None = None,
     groundtruth: Path | None = None,
     progress: bool | None = None,
     plot: bool = True,
@@ -89,17 +92,20 @@ def run_dataset(
     """Runs the odometry over `dataset` and writes the outputs listed in the module doc.
 
     use_imu False runs LiDAR-only even when the recording has an IMU; on_frame(i, scan, frame
-    result) is called after every processed scan (a live view)."""
-    run = OdometryRun(dataset, Path(out_dir), config or _core.Config())
+    result) is called after every processed scan (a live view). save_map (or maps.save) writes the
+    whole map; maps.prior_map localizes in a prior map (summary["localization"])."""
+    maps = maps or MapOptions()
+    maps.save = maps.save or save_map
+    run = OdometryRun(dataset, Path(out_dir), config or _core.Config(), maps)
     run.open_outputs(options or replay_options(), use_imu)
     try:
         run.run_frames(max_frames, progress, on_frame)
     except KeyboardInterrupt:  # SIGINT, or SIGTERM through the CLI: what was done so far is kept
         run.write_summary(run.summarise() | {"interrupted": True})
         raise
-    if save_map:
-        run.save_map()
     summary = run.summarise()
+    if run.whole_map is not None:
+        summary["map"] = run.whole_map.write(run.out_dir, run.out_dir / SCANS_LIDAR_TUM, plot)
     run.evaluate(summary, groundtruth, plot)
     if plot:
         run.plot(summary)
@@ -120,13 +126,18 @@ class FrameCounts:
     degenerate: int = 0  # registered frames with a degenerate direction
     failed: int = 0  # registrations whose pose was not used (too few inliers, non-finite)
     map_restarts: int = 0  # the map restarted after failures (recovery)
+    lost: int = 0  # localization: scans that did not match the prior map
+    last_lost: bool = False  # localization: the last processed scan did not
 
 
 class OdometryRun:
     """The odometry over one dataset and the files it writes as it goes (run_dataset's steps)."""
 
-    def __init__(self, dataset: Dataset, out_dir: Path, config: Any):
+    def __init__(self, dataset: Dataset, out_dir: Path, config: Any, maps: MapOptions | None = None):
         self.dataset, self.out_dir, self.config = dataset, out_dir, config
+        self.maps = maps or MapOptions()
+        self.whole_map = WholeMap(self.maps.resolution_m) if self.maps.save else None
+        self.prior_map_points = 0
         self.frames = 0
         self.counts = FrameCounts()
         self.lidar_poses = farlio.Trajectory()
@@ -147,6 +158,7 @@ class OdometryRun:
             self.imu_span = (min(imu_stamps), max(imu_stamps))
             self.check_clocks()
         self.odo = _core.Odometry(self.config, self.dataset.T_imu_lidar(), self.dataset.gravity_m_s2(), imu, options)
+        self.prior_map_points = load_prior_map(self.odo, self.maps)
         self.warn_from_odometry()
         if self.odo.device_message:
             print(f"farlio: {self.odo.device_message}", file=sys.stderr)
@@ -227,6 +239,8 @@ class OdometryRun:
             self.counts.dropped += 1
             return
         self.record(fr)
+        if self.whole_map is not None:
+            self.whole_map.add(self.odo, scan, fr)
         if on_frame is not None:
             on_frame(i, scan, fr)
         bar.update(i + 1, f"{fr.scan.timings.total_s * MS_PER_S:6.1f} ms")
@@ -272,13 +286,10 @@ class OdometryRun:
         self.counts.converged += int(r.registered and r.converged and not r.failure)
         self.counts.failed += int(bool(r.failure))
         self.counts.map_restarts += int(r.map_restarted)
+        self.counts.lost += int(r.lost)
+        self.counts.last_lost = r.lost
         self.counts.dropped += int(bool(fr.drop_reason))
         self.counts.degenerate += int(fr.degeneracy is not None and fr.degeneracy.degenerate)
-
-    def save_map(self) -> None:
-        submap = farlio.Scan(self.odo.map_points())
-        _core.io.write_ply(self.out_dir / MAP_PLY, submap)
-        _core.io.write_pcd(self.out_dir / MAP_PCD, submap)
 
     def summarise(self) -> dict[str, Any]:
         c, totals = self.counts, self.counts.totals_ms
@@ -310,6 +321,17 @@ class OdometryRun:
         stats = self.odo.fusion_stats
         if stats is not None:
             summary["fusion"] = _fusion_summary(stats)
+        if self.maps.prior_map is not None:
+            summary["localization"] = {
+                "prior_map": str(self.maps.prior_map),
+                "prior_map_points": self.prior_map_points,
+                "initial_pose": list(self.maps.initial_pose) if self.maps.initial_pose is not None else None,
+                "frames_localized": len(totals) - c.lost,
+                "frames_lost": c.lost,
+                "localized_at_end": bool(totals) and not c.last_lost,
+                # a run lost in most of its scans has not localized (a wrong map or initial pose)
+                "localized": len(totals) > 2 * c.lost,
+            }
         return summary
 
     def evaluate(self, summary: dict[str, Any], groundtruth: Path | None, plot: bool) -> None:
@@ -398,6 +420,15 @@ def format_summary(s: dict[str, Any]) -> str:
             f"registration failed on {s['registration_failed']} scans (kept the prediction; timing.csv drop_reason), "
             f"map restarts {s.get('map_restarts', 0)}"
         )
+    loc = s.get("localization")
+    if loc:
+        lines.append(
+            f"localization in {loc['prior_map']}: {loc['frames_localized']} scans localized, {loc['frames_lost']} lost "
+            "(timing.csv lost, inlier_fraction)"
+        )
+    if s.get("map"):
+        m = s["map"]
+        lines.append(f"map: {m['points']} points at {m['resolution_m'] or 0:.2f} m (map.pcd, map.ply, map.png)")
     for key, label in (("accuracy", "scan poses"), ("accuracy_odometry", "100 Hz odometry")):
         if s.get(key):
             lines.append(f"{label}: {_accuracy_line(s[key])}")

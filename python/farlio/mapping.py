@@ -1,0 +1,109 @@
+"""Maps of a run: the whole map written with --save-map (map.pcd, map.ply, map.png), and
+localization in a prior map with --prior-map (the map's frame is the world frame of the run).
+
+The whole map is accumulated as the run goes (_core.MapExport: every scan whose pose was used,
+undistorted, at its registered pose, one centroid per cell of the export resolution), so its memory
+grows with the mapped volume, not with the run's length; it is written at the end of the run."""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Sequence
+
+import numpy as np
+
+import farlio
+from farlio import _core
+
+MAP_PLY, MAP_PCD = "map.ply", "map.pcd"
+MS_PER_S = 1e3
+#: --initial-pose: X Y Z in metres, ROLL PITCH YAW in degrees
+INITIAL_POSE_VALUES = 6
+
+
+@dataclass
+class MapOptions:
+    """What a run does with maps: save (--save-map) at resolution_m (None: the config's
+    map.export_resolution_m, whose 0 means the map's point spacing); localize in prior_map
+    (--prior-map) starting from initial_pose (X Y Z m, ROLL PITCH YAW deg; None: the origin)."""
+
+    save: bool = False
+    resolution_m: float | None = None
+    prior_map: Path | None = None
+    initial_pose: Sequence[float] | None = None
+
+
+def pose_from_xyz_rpy_deg(values: Sequence[float]) -> Any:
+    """The SE3 of X Y Z (m) and ROLL PITCH YAW (deg), R = Rz(yaw) Ry(pitch) Rx(roll)."""
+    if len(values) != INITIAL_POSE_VALUES or not all(math.isfinite(v) for v in values):
+        raise ValueError(f"an initial pose is X Y Z ROLL PITCH YAW (6 finite numbers), got {list(values)}")
+    x, y, z, roll, pitch, yaw = (float(v) for v in values)
+    r, p, w = np.radians([roll, pitch, yaw])
+    rx = np.array([[1, 0, 0], [0, math.cos(r), -math.sin(r)], [0, math.sin(r), math.cos(r)]])
+    ry = np.array([[math.cos(p), 0, math.sin(p)], [0, 1, 0], [-math.sin(p), 0, math.cos(p)]])
+    rz = np.array([[math.cos(w), -math.sin(w), 0], [math.sin(w), math.cos(w), 0], [0, 0, 1]])
+    m = np.eye(4)
+    m[:3, :3] = rz @ ry @ rx
+    m[:3, 3] = (x, y, z)
+    return _core.SE3.from_matrix(m)
+
+
+def load_prior_map(odo: Any, options: MapOptions) -> int:
+    """Hands the prior map and the initial pose to the odometry before its first scan; returns the
+    map's point count. ValueError naming the file when it cannot be read or holds no point."""
+    if options.initial_pose is not None:
+        odo.set_initial_pose(pose_from_xyz_rpy_deg(options.initial_pose))
+    if options.prior_map is None:
+        return 0
+    cloud = _core.io.read_point_cloud(Path(options.prior_map))
+    cloud.remove_non_finite()
+    if len(cloud) == 0:
+        raise ValueError(f"{options.prior_map}: the prior map holds no point")
+    odo.set_prior_map(cloud)
+    return len(cloud)
+
+
+class WholeMap:
+    """The whole map of a run under construction (--save-map) and its files."""
+
+    def __init__(self, resolution_m: float | None):
+        self.requested_resolution_m = resolution_m
+        self.export: Any = None
+        self.add_ms: list[float] = []
+
+    def add(self, odo: Any, scan: Any, frame: Any) -> None:
+        """A processed scan whose pose was used (not a failure, not lost in a prior map)."""
+        r = frame.scan
+        if not frame.processed or r.failure:
+            return
+        if self.export is None:  # the export resolution may follow the voxel size fixed at the first scan
+            config = odo.effective_config
+            if self.requested_resolution_m is not None:
+                config.set("map.export_resolution_m", self.requested_resolution_m)
+            self.export = _core.MapExport(_core.export_resolution_m(config), config)
+        start = time.perf_counter()
+        self.export.add(scan, r)
+        self.add_ms.append((time.perf_counter() - start) * MS_PER_S)
+
+    def write(self, out_dir: Path, trajectory: Path, plot: bool) -> dict[str, Any]:
+        """map.pcd and map.ply (x y z intensity, world frame) and map.png; returns the summary's
+        "map" entry (cells, resolution, memory, time per scan)."""
+        points = self.export.points() if self.export is not None else farlio.Scan(np.zeros((0, 3), np.float32))
+        _core.io.write_pcd(out_dir / MAP_PCD, points)
+        _core.io.write_ply(out_dir / MAP_PLY, points)
+        if plot:
+            from .plots import MAP_PNG, plot_map
+
+            plot_map(np.asarray(points.points), trajectory, out_dir / MAP_PNG)
+        e = self.export
+        return {
+            "points": len(points),
+            "resolution_m": e.resolution_m if e else None,
+            "points_added": e.points_added if e else 0,
+            "memory_bytes": e.memory_bytes if e else 0,
+            "add_ms_median": float(np.median(self.add_ms)) if self.add_ms else None,
+            "add_ms_p99": float(np.percentile(self.add_ms, 99)) if self.add_ms else None,
+        }
