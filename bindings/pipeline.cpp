@@ -14,9 +14,9 @@
 #include "bindings.hpp"
 #include "farlio/core/clock_check.hpp"
 #include "farlio/core/config_fields.hpp"
+#include "farlio/pipeline/map_export.hpp"
 #include "farlio/pipeline/odometry.hpp"
 #include "farlio/pipeline/online_odometry.hpp"
-#include "farlio/pipeline/map_export.hpp"
 #include "farlio/pipeline/pairwise.hpp"
 #include "farlio/pipeline/scan_pipeline.hpp"
 #include "repr.hpp"
@@ -322,16 +322,14 @@ void bind_pipeline(nb::module_& m) {
           },
           "[(stamp_ns, body pose)] of the 10 ms odometry output since the last call.")
       .def(
-          "set_initial_pose", [](PyOdometry& o, const SE3& pose) { o.odometry.set_initial_pose(pose); },
-          "body_pose"_a,
+          "set_initial_pose", [](PyOdometry& o, const SE3& pose) { o.odometry.set_initial_pose(pose); }, "body_pose"_a,
           "The body pose at the first scan in the world (the prior map's frame): position and yaw as given; roll "
           "and pitch too when LiDAR-only, from gravity when inertial. Before the first scan.")
       .def(
           "set_prior_map", [](PyOdometry& o, const Scan& map) { o.odometry.set_prior_map(map.points); }, "map"_a,
           "Localization: the submap is built from the points of `map` (world frame) and held fixed. Before the "
           "first scan.")
-      .def_prop_ro("localizing",
-                   [](const PyOdometry& o) { return o.odometry.scan_pipeline().localizing(); })
+      .def_prop_ro("localizing", [](const PyOdometry& o) { return o.odometry.scan_pipeline().localizing(); })
       .def_prop_ro("inertial", [](const PyOdometry& o) { return o.odometry.inertial(); })
       .def(
           "take_warnings", [](PyOdometry& o) { return o.odometry.take_warnings(); },
@@ -364,7 +362,7 @@ void bind_pipeline(nb::module_& m) {
       .def(
           "__init__",
           [](pipeline::MapExport* self, double resolution_m, const Config& config) {
-            new (self) pipeline::MapExport(resolution_m, config.preprocess);
+            new (self) pipeline::MapExport(resolution_m, config.preprocess, config.num_threads);
           },
           "resolution_m"_a, "config"_a)
       .def(
@@ -419,6 +417,12 @@ void bind_pipeline(nb::module_& m) {
           "map_points", [](const PyOnlineOdometry& o) { return map_points(o.odometry.map_snapshot()); },
           nb::call_guard<nb::gil_scoped_release>(),
           "(N, 3) float32 copy of the submap's points (world frame); waits for the scan in progress")
+      .def(
+          "set_initial_pose", [](PyOnlineOdometry& o, const SE3& pose) { o.odometry.set_initial_pose(pose); },
+          "body_pose"_a, "As Odometry.set_initial_pose; before the first scan.")
+      .def(
+          "set_prior_map", [](PyOnlineOdometry& o, const Scan& map) { o.odometry.set_prior_map(map.points); }, "map"_a,
+          nb::call_guard<nb::gil_scoped_release>(), "As Odometry.set_prior_map; before the first scan.")
       .def_prop_ro("inertial", [](PyOnlineOdometry& o) { return o.odometry.inertial(); })
       .def(
           "take_warnings", [](PyOnlineOdometry& o) { return o.odometry.take_warnings(); },

@@ -68,8 +68,15 @@ def plot_map(points: np.ndarray, trajectory: Path, path: Path) -> None:
         order = np.argsort(pts[:, 2])  # high points drawn last (roofs over the ground)
         lo, hi = np.percentile(pts[:, 2], HEIGHT_PERCENTILES)
         sc = ax.scatter(
-            pts[order, 0], pts[order, 1], c=pts[order, 2], s=MAP_POINT_SIZE, cmap="viridis", vmin=lo, vmax=max(hi, lo + 1e-3),
-            linewidths=0, rasterized=True,
+            pts[order, 0],
+            pts[order, 1],
+            c=pts[order, 2],
+            s=MAP_POINT_SIZE,
+            cmap="viridis",
+            vmin=lo,
+            vmax=max(hi, lo + 1e-3),
+            linewidths=0,
+            rasterized=True,
         )
         fig.colorbar(sc, ax=ax, shrink=0.7, label="height z [m]")
     if Path(trajectory).exists():
@@ -80,7 +87,7 @@ def plot_map(points: np.ndarray, trajectory: Path, path: Path) -> None:
             ax.legend(loc="upper right")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
-    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_aspect("equal", adjustable="box")  # the axes fit the map, not the square figure
     ax.set_title(f"map: {len(points)} points")
     fig.tight_layout()
     fig.savefig(path, dpi=DPI)

@@ -162,6 +162,34 @@ TEST(Sequence, ImuBackwardsSampleDroppedWithWarning) {
   EXPECT_TRUE(found);
 }
 
+TEST(Sequence, ImuNonFiniteSamplesDroppedWithWarnings) {
+  // a sensor's NaN or inf drops its sample (named), the run goes on; text that is no number stays
+  // an error naming the line
+  TempDir tmp;
+  SequenceWriter w(tmp.path());
+  w.write_calibration(Calibration{});
+  Scan s = test::random_scan(10, 1);
+  s.end_stamp_ns = 100;
+  w.write_scan(s);
+  std::string csv = "t_ns,gx,gy,gz,ax,ay,az\n";
+  for (int k = 1; k <= 20; ++k) {
+    const bool bad = k % 4 == 0 || k > 14;  // 4, 8, 12, 15..20: 9 samples
+    csv += std::to_string(k * 1000) + (bad ? ",nan,0,0,0,0,9.81\n" : ",0,0,0,0,0,9.81\n");
+  }
+  csv += "21000,0,0,0,0,inf,9.81\n22000,0,0,0,0,-INF,9.81\n23000,0,0,0,0,0,9.81\n";
+  test::write_raw(tmp.path() / "imu.csv", csv);
+  SequenceReader r(tmp.path());
+  ASSERT_EQ(r.imu().size(), 12u);  // 23 - 11
+  for (const auto& sample : r.imu()) EXPECT_TRUE(sample.accel_m_s2.allFinite() && sample.gyro_rad_s.allFinite());
+  const auto warn = r.warnings();
+  ASSERT_EQ(warn.size(), 11u);  // 10 named, then the count
+  EXPECT_NE(warn[0].find("imu.csv:5: gx 'nan' is not finite; sample dropped"), std::string::npos) << warn[0];
+  EXPECT_NE(warn[10].find("11 samples with a nan or inf value dropped"), std::string::npos) << warn[10];
+
+  test::write_raw(tmp.path() / "imu.csv", "t_ns,gx,gy,gz,ax,ay,az\n1000,0,0,abc,0,0,9.81\n");
+  test::expect_input_error([&] { SequenceReader bad(tmp.path()); }, tmp.path() / "imu.csv", "gz 'abc' is not a number");
+}
+
 TEST(Sequence, BadFoldersThrow) {
   TempDir tmp;
   const auto d = tmp.path();

@@ -44,7 +44,9 @@ def _poses(path: Path) -> dict[int, np.ndarray]:
 
 def _errors(estimate: dict[int, np.ndarray], reference: dict[int, np.ndarray]) -> np.ndarray:
     """Position error of every stamp both have, in stamp order."""
-    return np.array([np.linalg.norm(estimate[s][:3, 3] - reference[s][:3, 3]) for s in sorted(estimate) if s in reference])
+    return np.array(
+        [np.linalg.norm(estimate[s][:3, 3] - reference[s][:3, 3]) for s in sorted(estimate) if s in reference]
+    )
 
 
 @pytest.fixture(scope="module")
@@ -170,3 +172,35 @@ def test_an_empty_prior_map_names_the_file(tmp_path, capsys):
     _core.io.write_pcd(empty, _core.Scan(np.zeros((0, 3), np.float32)))
     assert cli(["run", str(seq), "--out", str(tmp_path / "o"), "--prior-map", str(empty), "--no-progress"]) == 2
     assert "empty.pcd" in capsys.readouterr().err
+
+
+def test_online_odometry_localizes_as_the_replay_does(mapped):
+    """OnlineOdometry.set_prior_map / set_initial_pose (the ROS 2 node's prior_map and initial_pose)
+    give the replay's localization, fed in lockstep with zero latency."""
+    root, _ = mapped
+    ds = open_dataset(root / "pass_seq")
+    scans = [ds.scan(i) for i in range(30)]
+    imu, T, g = ds.imu(), ds.T_imu_lidar(), ds.gravity_m_s2()
+    prior = _core.io.read_point_cloud(root / "mapping" / "map.pcd")
+    start = pose_from_xyz_rpy_deg([0.3, -0.2, 0.0, 0.0, 0.0, 1.0])
+    replay = _core.Odometry(load_config(None, []), T, g, imu, replay_options("zero"))
+    replay.set_prior_map(prior)
+    replay.set_initial_pose(start)
+    expected = [replay.process(s) for s in scans]
+    online = _core.OnlineOdometry(load_config(None, []), T, g)
+    online.set_prior_map(prior)
+    online.set_initial_pose(start)
+    k = 0
+    for s in scans:
+        while k < len(imu) and imu[k].stamp_ns <= s.end_stamp_ns:
+            online.add_imu(imu[k])
+            k += 1
+        assert online.add_scan(s)
+        online.wait_idle()
+    online.stop()
+    frames = online.take_frames()
+    assert len(frames) == len(scans) and not any(f.scan.lost for f in frames)
+    got = np.array([f.body_pose.translation for f in frames])
+    assert np.abs(got - np.array([e.body_pose.translation for e in expected])).max() < 1e-6
+    with pytest.raises(RuntimeError, match="after the first scan"):
+        online.set_initial_pose(start)

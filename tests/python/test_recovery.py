@@ -114,8 +114,8 @@ def test_a_bogus_scan_is_not_trusted(tmp_path, clean):
 
 def test_corrupt_imu_samples_are_rejected(tmp_path, clean):
     """A bit flip (1e30 m/s^2), a 1e4 m/s^2 spike and a 30 rad/s gyro glitch in imu.csv: rejected
-    and reported, accuracy as without them. (A NaN in imu.csv is the reader's error naming the
-    line; the gate's NaN case is tested in test_imu_gate.cpp.)"""
+    and reported, accuracy as without them. (A NaN in imu.csv is dropped by the reader with a
+    warning naming the line, test_io_sequence.cpp; the gate's NaN case is test_imu_gate.cpp.)"""
     seq, clean_summary = clean
     bad = _copy_sequence(seq, tmp_path / "seq")
     lines = (bad / "imu.csv").read_text().splitlines()

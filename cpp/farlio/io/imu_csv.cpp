@@ -19,6 +19,8 @@ constexpr std::size_t kStampColumn = 0;
 constexpr std::size_t kGyroColumn = 1;
 constexpr std::size_t kAccelColumn = 4;
 constexpr std::size_t kAxes = 3;
+/// Samples with a nan or inf value are named one by one up to this many, then counted.
+constexpr std::size_t kNamedNonFiniteSamples = 10;
 
 std::vector<std::string_view> split_commas(std::string_view line) {
   std::vector<std::string_view> out;
@@ -70,6 +72,7 @@ std::vector<ImuSample> parse_imu_csv(std::istream& in, const std::string& file, 
   }
 
   std::vector<ImuSample> samples;
+  std::size_t non_finite_samples = 0;
   while (std::getline(in, line)) {
     ++line_no;
     const auto t = trim(line);
@@ -84,16 +87,26 @@ std::vector<ImuSample> parse_imu_csv(std::istream& in, const std::string& file, 
     const auto stamp = parse_int64(fields[col[kStampColumn]]);
     if (!stamp) throw InputError(where + ": t_ns '" + std::string(fields[col[kStampColumn]]) + "' is not an integer");
     s.stamp_ns = *stamp;
+    std::string non_finite;  // the first column that reads nan or inf
     for (std::size_t axis = 0; axis < kAxes; ++axis) {
       for (std::size_t base : {kGyroColumn, kAccelColumn}) {
         const auto tok = fields[col[base + axis]];
         const auto v = parse_double(tok);
-        if (!v || !std::isfinite(*v)) {
+        if (!v) {
           throw InputError(where + ": " + std::string(kColumns[base + axis]) + " '" + std::string(tok) +
-                           "' is not a finite number");
+                           "' is not a number");
+        }
+        if (!std::isfinite(*v) && non_finite.empty()) {
+          non_finite = std::string(kColumns[base + axis]) + " '" + std::string(tok) + "'";
         }
         (base == kGyroColumn ? s.gyro_rad_s : s.accel_m_s2)[static_cast<Eigen::Index>(axis)] = *v;
       }
+    }
+    if (!non_finite.empty()) {  // a sensor's NaN: the sample is dropped, the recording stays usable
+      if (++non_finite_samples <= kNamedNonFiniteSamples) {
+        warnings.push_back(where + ": " + non_finite + " is not finite; sample dropped");
+      }
+      continue;
     }
     if (!samples.empty() && s.stamp_ns <= samples.back().stamp_ns) {
       warnings.push_back(where + ": sample at " + std::to_string(s.stamp_ns) + " ns is not after the previous one (" +
@@ -101,6 +114,11 @@ std::vector<ImuSample> parse_imu_csv(std::istream& in, const std::string& file, 
       continue;
     }
     samples.push_back(s);
+  }
+  if (non_finite_samples > kNamedNonFiniteSamples) {
+    warnings.push_back(file + ": " + std::to_string(non_finite_samples) +
+                       " samples with a nan or inf value dropped in all (the first " +
+                       std::to_string(kNamedNonFiniteSamples) + " named above)");
   }
   return samples;
 }

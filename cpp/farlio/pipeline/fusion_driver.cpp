@@ -7,6 +7,7 @@
 #include "farlio/core/config_fields.hpp"
 #include "farlio/core/time.hpp"
 #include "farlio/deskew/motion_fit.hpp"
+#include "farlio/fusion/euler.hpp"
 #include "farlio/fusion/lidar_measurement.hpp"
 
 namespace farlio::pipeline {
@@ -188,8 +189,13 @@ void FusionDriver::apply_gyro_unit() {
   recent_imu_.clear();
 }
 
-SE3 FusionDriver::start_pose(std::int64_t first_scan_end_ns) const {
-  return fusion_ ? gravity_aligned_start(startup_imu_, first_scan_end_ns) : SE3();
+SE3 FusionDriver::start_pose(std::int64_t first_scan_end_ns, const std::optional<SE3>& requested) const {
+  if (!fusion_) return requested.value_or(SE3());
+  const SE3 level = gravity_aligned_start(startup_imu_, first_scan_end_ns);
+  if (!requested) return level;
+  Eigen::Vector3d rpy = fusion::euler_from_rotation(level.rotation());
+  rpy.z() = fusion::euler_from_rotation(requested->rotation()).z();
+  return SE3(fusion::rotation_from_euler(rpy), requested->translation());
 }
 
 ScanPrior FusionDriver::prior(const Scan& scan) const {

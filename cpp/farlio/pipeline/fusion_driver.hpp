@@ -88,7 +88,10 @@ class FusionDriver {
   [[nodiscard]] std::int64_t clock_ns() const { return clock_ns_; }
   /// The body pose the world frame starts from, for a first scan ending at first_scan_end_ns:
   /// roll and pitch from gravity when inertial (gravity_aligned_start), else the identity.
-  [[nodiscard]] SE3 start_pose(std::int64_t first_scan_end_ns) const;
+  /// With `requested` (a body pose the user gives, e.g. in a prior map): its position and yaw, and
+  /// its roll and pitch too when there is no fusion (with one, the IMU measures them).
+  [[nodiscard]] SE3 start_pose(std::int64_t first_scan_end_ns,
+                               const std::optional<SE3>& requested = std::nullopt) const;
 
   /// The initial guess and the motion during the scan, from the fusion (empty: LiDAR-only, or
   /// before the filter is initialised).

@@ -15,8 +15,8 @@ double export_resolution_m(const Config& config) {
   return config.map.export_resolution_m > 0.0 ? config.map.export_resolution_m : map::point_spacing_m(config.map);
 }
 
-MapExport::MapExport(double resolution_m, const PreprocessConfig& preprocess)
-    : resolution_m_(resolution_m), preprocess_(preprocess) {
+MapExport::MapExport(double resolution_m, const PreprocessConfig& preprocess, int num_threads)
+    : resolution_m_(resolution_m), preprocess_(preprocess), executor_(num_threads) {
   if (!(resolution_m >= kMinVoxelSize_m && resolution_m <= kMaxVoxelSize_m)) {
     throw std::invalid_argument("map export resolution must be in [" + std::to_string(kMinVoxelSize_m) + ", " +
                                 std::to_string(kMaxVoxelSize_m) + "] m, got " + std::to_string(resolution_m));
@@ -31,21 +31,35 @@ std::size_t MapExport::add(const Scan& scan, const deskew::ScanMotion& motion, b
   const Eigen::Vector3d t = pose.translation();
   const auto inv_cell = static_cast<float>(1.0 / resolution_m_);
   const bool has_intensity = scan.intensity.size() == scan.size();
-  std::size_t added = 0;
-  for (std::size_t i = 0; i < scan.size(); ++i) {
+  const std::size_t n = scan.size();
+  keys_.resize(n);
+  offsets_.resize(n);
+  // per point, in parallel: crop, undistortion, world position, its cell and the offset in it
+  executor_.for_each(n, [&](std::size_t i) {
     Eigen::Vector3f p;
-    if (preprocess_point(scan.points[i], deskew ? scan.time_s[i] : 0.0f, pp, &p) == map::kEmptyKey) continue;
+    keys_[i] = map::kEmptyKey;
+    if (preprocess_point(scan.points[i], deskew ? scan.time_s[i] : 0.0f, pp, &p) == map::kEmptyKey) return;
     const Eigen::Vector3d w = R * p.cast<double>() + t;
     const std::uint64_t key = map::point_key(w.cast<float>(), inv_cell);
-    if (key == map::kEmptyKey) continue;
-    const Eigen::Vector3d corner = map::unpack_key(key).cast<double>() * resolution_m_;
-    const Eigen::Vector3f d = (w - corner).cast<float>();
-    Cell& c = cells_[key];
-    c.dx += d.x();
-    c.dy += d.y();
-    c.dz += d.z();
-    c.intensity += has_intensity ? scan.intensity[i] : 0.0f;
-    ++c.count;
+    if (key == map::kEmptyKey) return;
+    keys_[i] = key;
+    offsets_[i] = (w - map::unpack_key(key).cast<double>() * resolution_m_).cast<float>();
+  });
+  // accumulation in scan order (deterministic); neighbours along a scan line often share a cell
+  std::size_t added = 0;
+  std::uint64_t last_key = map::kEmptyKey;
+  Cell* cell = nullptr;  // unordered_map nodes do not move on a rehash
+  for (std::size_t i = 0; i < n; ++i) {
+    if (keys_[i] == map::kEmptyKey) continue;
+    if (keys_[i] != last_key) {
+      last_key = keys_[i];
+      cell = &cells_[last_key];
+    }
+    cell->dx += offsets_[i].x();
+    cell->dy += offsets_[i].y();
+    cell->dz += offsets_[i].z();
+    cell->intensity += has_intensity ? scan.intensity[i] : 0.0f;
+    ++cell->count;
     ++added;
   }
   points_added_ += added;

@@ -19,6 +19,7 @@
 #include "farlio/core/se3.hpp"
 #include "farlio/core/types.hpp"
 #include "farlio/deskew/scan_motion.hpp"
+#include "farlio/exec/cpu_executor.hpp"
 
 namespace farlio::pipeline {
 
@@ -28,7 +29,8 @@ double export_resolution_m(const Config& config);
 class MapExport {
  public:
   /// Throws std::invalid_argument unless resolution_m is in [kMinVoxelSize_m, kMaxVoxelSize_m].
-  MapExport(double resolution_m, const PreprocessConfig& preprocess);
+  /// The per-point work runs on num_threads (0: all), the accumulation on the caller's thread.
+  MapExport(double resolution_m, const PreprocessConfig& preprocess, int num_threads = 0);
 
   /// Adds `scan` (LiDAR frame, raw) undistorted with `motion` (when `undistort`) and placed at
   /// `pose` (the LiDAR pose at the scan end in the world). Returns the points added (cropped,
@@ -53,8 +55,10 @@ class MapExport {
   PreprocessConfig preprocess_;
   std::unordered_map<std::uint64_t, Cell> cells_;
   std::size_t points_added_ = 0;
-  // per-scan buffers, reused
-  std::vector<Eigen::Vector3f> deskewed_;
+  exec::CpuExecutor executor_;
+  // per-scan buffers, reused: each point's cell key and its offset from the cell's corner
+  std::vector<std::uint64_t> keys_;
+  std::vector<Eigen::Vector3f> offsets_;
 };
 
 }  // namespace farlio::pipeline

@@ -6,7 +6,6 @@
 #include "farlio/core/clock_check.hpp"
 #include "farlio/core/error.hpp"
 #include "farlio/core/time.hpp"
-#include "farlio/fusion/euler.hpp"
 #include "farlio/fusion/gyro_unit_detector.hpp"
 
 namespace farlio::pipeline {
@@ -126,14 +125,7 @@ OdometryFrame Odometry::process(const Scan& scan) {
   advance_clock(out.started_ns);
   if (pipeline_.frames() == 0 && (driver_.inertial() || requested_initial_pose_)) {
     // roll and pitch from the IMU seen so far; position and yaw as requested
-    initial_body_pose_ = driver_.inertial() ? driver_.start_pose(scan.end_stamp_ns) : SE3();
-    if (requested_initial_pose_ && driver_.inertial()) {
-      Eigen::Vector3d rpy = fusion::euler_from_rotation(initial_body_pose_.rotation());
-      rpy.z() = fusion::euler_from_rotation(requested_initial_pose_->rotation()).z();
-      initial_body_pose_ = SE3(Eigen::Quaterniond(fusion::rotation_from_euler(rpy)), requested_initial_pose_->translation());
-    } else if (requested_initial_pose_) {
-      initial_body_pose_ = *requested_initial_pose_;
-    }
+    initial_body_pose_ = driver_.start_pose(scan.end_stamp_ns, requested_initial_pose_);
     pipeline_.reset_initial_pose(initial_body_pose_ * T_imu_lidar_);
   }
 

@@ -1,5 +1,7 @@
 #include "farlio/pipeline/online_odometry.hpp"
 
+#include <stdexcept>
+
 #include "farlio/core/config_fields.hpp"
 #include "farlio/core/time.hpp"
 
@@ -84,6 +86,17 @@ void OnlineOdometry::worker_loop() {
   }
 }
 
+void OnlineOdometry::set_initial_pose(const SE3& body_pose) {
+  std::lock_guard lock(state_mutex_);
+  if (started_) throw std::logic_error("OnlineOdometry::set_initial_pose after the first scan");
+  requested_initial_pose_ = body_pose;
+}
+
+void OnlineOdometry::set_prior_map(std::vector<Eigen::Vector3f> world_points) {
+  std::lock_guard lock(pipeline_mutex_);
+  pipeline_.set_prior_map(std::move(world_points));  // throws after the first scan
+}
+
 OdometryFrame OnlineOdometry::process(const Scan& scan) {
   OdometryFrame out;
   ScanPrior prior;
@@ -92,7 +105,7 @@ OdometryFrame OnlineOdometry::process(const Scan& scan) {
     std::lock_guard lock(state_mutex_);
     if (!started_) {  // the first scan fixes the start pose (gravity aligned when the IMU came first)
       started_ = true;
-      pipeline_.reset_initial_pose(driver_.start_pose(scan.end_stamp_ns) * T_imu_lidar_);
+      pipeline_.reset_initial_pose(driver_.start_pose(scan.end_stamp_ns, requested_initial_pose_) * T_imu_lidar_);
     }
     prior = driver_.prior(scan);
     out.started_ns = fused_clock() ? driver_.clock_ns() : scan.end_stamp_ns;

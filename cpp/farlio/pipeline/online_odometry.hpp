@@ -47,6 +47,11 @@ class OnlineOdometry {
   OnlineOdometry(const OnlineOdometry&) = delete;
   OnlineOdometry& operator=(const OnlineOdometry&) = delete;
 
+  /// The body pose at the first scan (Odometry::set_initial_pose) and a prior map to localize in
+  /// (ScanPipeline::set_prior_map); before the first scan (std::logic_error after).
+  void set_initial_pose(const SE3& body_pose);
+  void set_prior_map(std::vector<Eigen::Vector3f> world_points);
+
   /// Feeds the fusion and emits the odometry for every 10 ms step up to the sample's stamp.
   void add_imu(const ImuSample& sample);
   /// Hands the scan to the worker; false (and on_frame with the reason) when it is busy.
@@ -87,7 +92,8 @@ class OnlineOdometry {
   // fusion state, guarded by state_mutex_
   mutable std::mutex state_mutex_;
   FusionDriver driver_;
-  bool started_ = false;  ///< the first scan has set the start pose
+  bool started_ = false;                       ///< the first scan has set the start pose
+  std::optional<SE3> requested_initial_pose_;  ///< set_initial_pose
   std::size_t dropped_busy_ = 0;
 
   std::mutex emit_mutex_;  // keeps on_odometry calls in order

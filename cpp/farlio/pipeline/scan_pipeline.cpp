@@ -160,7 +160,8 @@ FrameResult ScanPipeline::process(const Scan& scan, const std::optional<SE3>& in
       failing_since_ns_.reset();
     }
   }
-  if (!localizing() && (out.failure.empty() || out.map_restarted)) out.map_insert = backend_->update_map(pose, limit, &out.removed_voxels);
+  if (!localizing() && (out.failure.empty() || out.map_restarted))
+    out.map_insert = backend_->update_map(pose, limit, &out.removed_voxels);
   out.map_voxels = backend_->map_voxels();
   out.map_points = backend_->map_points();
   out.timings.map_update_s = seconds_since(t0);

@@ -46,8 +46,8 @@ struct FrameResult {
   bool lost = false;
   deskew::ScanMotion motion;  ///< the motion the scan was undistorted with
   bool undistorted = false;   ///< whether it was (per-point times, preprocess.undistort, motion)
-  double sigma_m = 0;          ///< adaptive threshold used
-  int density_limit = 0;       ///< close-range per-voxel limit chosen by ASMD
+  double sigma_m = 0;         ///< adaptive threshold used
+  int density_limit = 0;      ///< close-range per-voxel limit chosen by ASMD
   std::size_t input_points = 0, kept_points = 0, source_points = 0;
   map::InsertStats map_insert;
   std::size_t map_voxels = 0, map_points = 0, removed_voxels = 0;
@@ -104,7 +104,7 @@ class ScanPipeline {
   std::int64_t last_stamp_ns_ = 0, prev_stamp_ns_ = 0;
   std::size_t frames_ = 0;
   bool scale_fixed_ = false;
-  std::optional<std::int64_t> failing_since_ns_;  ///< scan end of the first failure in a row
+  std::optional<std::int64_t> failing_since_ns_;           ///< scan end of the first failure in a row
   std::optional<std::vector<Eigen::Vector3f>> prior_map_;  ///< localization: the map held fixed
   bool prior_map_loaded_ = false;
 };

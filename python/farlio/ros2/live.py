@@ -20,6 +20,7 @@ from __future__ import annotations
 import time
 from collections import deque
 from dataclasses import dataclass, fields
+from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
@@ -29,6 +30,7 @@ from farlio._core import NS_PER_S
 
 from ..datasets.lidar_merge import TimedClouds, assemble, live_interval
 from ..datasets.pointcloud2 import Cloud, CloudError, decode, time_field_of
+from ..mapping import MapOptions, load_prior_map
 from .params import NodeParams
 
 #: clouds of another LiDAR kept while the reference LiDAR is silent
@@ -66,6 +68,7 @@ class Counters:
     scans_clock_mismatch: int = 0
     silent_topics: int = 0
     poses_non_finite: int = 0
+    scans_lost: int = 0  # localization: scans that did not match the prior map
     callback_errors: int = 0
 
     def as_dict(self) -> dict[str, int]:
@@ -106,6 +109,10 @@ class LiveOdometry:
         self.clock = clock
         self.stats = Counters()
         self.odometry = farlio.OnlineOdometry(config, extrinsics[0], gravity_m_s2, keep_registered_points)
+        # localization in a prior map (parameters prior_map, initial_pose), as `farlio run --prior-map`
+        requested_pose = list(params.initial_pose) if any(params.initial_pose) else None
+        load_prior_map(self.odometry, MapOptions(prior_map=Path(params.prior_map) if params.prior_map else None,
+                                                 initial_pose=requested_pose))  # fmt: skip
         self._time_options = params.time_options()
         self._offset_ns = int(round(params.time_offset_s * NS_PER_S))
         self._refs: deque[tuple[Cloud, int, tuple[int, int]]] = deque()  # reference clouds, arrival, interval

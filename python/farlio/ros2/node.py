@@ -194,6 +194,8 @@ class FarlioNode(Node):
                 self._publish_odometry(self._scan_out, stamp, f.body_pose)
             if p.publish_cloud_registered:
                 self._cloud_pub.publish(conv.points_msg(f.registered_points, stamp, p.odom_frame))
+        if f.processed and f.scan.lost:
+            self.live.report("scans_lost", f"scan at {stamp} ns lost in the prior map: {f.scan.failure}")
         stats = self.live.odometry.fusion_stats
         if stats is not None:
             self._gyro_bias = list(stats.gyro_bias_rad_s)
@@ -216,6 +218,8 @@ class FarlioNode(Node):
             "pipeline_ms": r.timings.total_s * MS_PER_S,
             "iterations": r.iterations,
             "converged": r.converged,
+            "inlier_fraction": r.inlier_fraction,
+            "lost": r.lost,
             "input_points": r.input_points,
             "kept_points": r.kept_points,
             "map_points": r.map_points,

@@ -70,6 +70,16 @@ class NodeParams:
     publish_cloud_registered: bool = _param(True, "publish the undistorted, registered scan on cloud_registered")
     local_map_period_s: float = _param(2.0, "period of the local_map publication (transient local); 0: never")
     map_file: str = _param("farlio_map.ply", "where the save_map service writes the submap (.ply or .pcd)")
+    prior_map: str = _param(
+        "",
+        "a map (map.pcd or map.ply of `farlio run --save-map`) to localize in: held fixed, odom_frame is its frame; "
+        "a scan matching less than localization.min_inlier_fraction of its points is lost (diagnostics); '': odometry",
+    )
+    initial_pose: list[float] = _param(
+        [0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        "body pose at the first scan in odom_frame (the prior map's frame): X Y Z (m) ROLL PITCH YAW (deg); with an "
+        "IMU roll and pitch come from gravity",
+    )
 
     def time_options(self) -> TimeOptions:
         return TimeOptions(self.time_field, self.time_unit, self.header_stamp)
@@ -87,6 +97,8 @@ class NodeParams:
         for name in ("imu_wait_s", "lidar_merge_wait_s", "silent_topic_timeout_s", "local_map_period_s"):
             if not getattr(self, name) >= 0:
                 raise ValueError(f"{name} {getattr(self, name)}: expected >= 0")
+        if len(self.initial_pose) != 6 or not all(abs(v) < float("inf") for v in self.initial_pose):
+            raise ValueError(f"initial_pose {self.initial_pose}: expected X Y Z ROLL PITCH YAW (6 finite numbers)")
         if not abs(self.time_offset_s) < float("inf"):
             raise ValueError(f"time_offset_s {self.time_offset_s}: expected a finite number")
 

@@ -1,0 +1,208 @@
+#!/usr/bin/env python3
+"""Maps (issue 15): map a generated sequence once, then run a second pass over the same scene (other
+noise seeds) twice, as odometry and localized in the saved map (`--prior-map`), with the same code
+path as `farlio run` (run_dataset) on scans generated in memory (no sequence on disk: a racetrack
+lap is ~7 GB of PCD). Prints per profile and pass seed:
+
+  APE            aligned translation RMSE against the ground truth (m)
+  err end        position error at the end of the pass, the estimate taken into the ground truth's
+                 frame by its first pose (localization: by the mapping run's first pose, the map's
+                 frame) (m); growth over the pass is drift
+  vs map end/max the position error against the mapping run's pose at the same stamp, i.e. against
+                 where the map says the scan is (only stamps the mapping run covers) (m)
+  lost, min inl  localization: scans lost, smallest inlier fraction
+  ms med/p99     per-frame processing time of the scan pipeline (same process, one after the other)
+
+and the map's size, memory and export time per scan; writes error_over_time_<profile>.png (the
+error in the ground truth's frame over time, odometry vs localization) and maps.json into --out.
+
+Usage: python scripts/measure_maps.py [--profiles urban handheld racetrack] [--pass-seeds 2 3]
+       [--out DIR]
+Racetrack: the map is the first lap (85 s), each pass two laps (165 s).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import tempfile
+from pathlib import Path
+
+import farlio
+import numpy as np
+from farlio import _core
+from farlio.config import load_config
+from farlio.datasets.base import Dataset
+from farlio.mapping import MAP_PCD, MapOptions
+from farlio.runner import SCANS_BODY_TUM, replay_options, run_dataset
+
+#: (map duration, pass duration) in seconds
+DURATIONS_S = {"urban": (60.0, 60.0), "handheld": (60.0, 60.0), "racetrack": (85.0, 165.0), "tunnel": (45.0, 45.0)}
+MAP_SEED = 1
+FIXED_LATENCY_S = 0.02
+
+
+class GeneratedDataset(Dataset):
+    """A generated sequence served from memory, scan by scan, with its ground truth as TUM files."""
+
+    def __init__(self, profile: str, seed: int, duration_s: float, work: Path):
+        cfg = _core.sim.default_config(profile)
+        cfg.seed, cfg.duration_s = seed, duration_s
+        self.gen = _core.sim.SequenceGenerator(cfg)
+        self.path = work / f"{profile}-{seed}"
+        self.path.mkdir(parents=True, exist_ok=True)
+        self.gt_scans = self.path / "groundtruth_scans.tum"
+        _core.io.write_tum(self.gt_scans, self.gen.groundtruth_scans())
+
+    def __len__(self) -> int:
+        return self.gen.num_scans()
+
+    def scan(self, i: int) -> farlio.Scan:
+        return self.gen.scan(i)
+
+    def imu(self) -> list:
+        return self.gen.imu()
+
+    def T_imu_lidar(self) -> farlio.SE3:
+        return self.gen.T_imu_lidar()
+
+    def gravity_m_s2(self) -> float:
+        return self.gen.gravity_m_s2()
+
+    def groundtruth_scans_file(self) -> Path:
+        return self.gt_scans
+
+
+def poses(path: Path) -> dict[int, np.ndarray]:
+    t = _core.io.read_trajectory(path)
+    return {t[i][0]: t[i][1].matrix() for i in range(len(t))}
+
+
+def error_in_gt_frame(est: dict, gt: dict, frame_est: dict) -> tuple[np.ndarray, np.ndarray]:
+    """(seconds from the start, position error) of est against gt, est taken into gt's frame by the
+    first pose of frame_est (est itself, or the mapping run whose frame a localization shares)."""
+    s0 = min(frame_est)
+    T = gt[s0] @ np.linalg.inv(frame_est[s0])
+    stamps = [s for s in sorted(est) if s in gt]
+    err = np.array([np.linalg.norm((T @ est[s])[:3, 3] - gt[s][:3, 3]) for s in stamps])
+    return (np.array(stamps) - stamps[0]) / 1e9, err
+
+
+def run(dataset: Dataset, out: Path, maps: MapOptions) -> dict:
+    return run_dataset(
+        dataset, out, load_config(None, []), progress=False, plot=False, maps=maps,
+        options=replay_options("fixed", FIXED_LATENCY_S),
+    )  # fmt: skip
+
+
+def frame_ms(out: Path) -> tuple[float, float]:
+    import csv
+
+    with open(out / "timing.csv") as f:
+        ms = [float(r["total_ms"]) for r in csv.DictReader(f) if r["total_ms"]]
+    return float(np.median(ms)), float(np.percentile(ms, 99))
+
+
+def measure(profile: str, pass_seeds: list[int], out: Path, work: Path) -> dict:
+    map_s, pass_s = DURATIONS_S[profile]
+    mapping = run(GeneratedDataset(profile, MAP_SEED, map_s, work), work / f"{profile}-map", MapOptions(save=True))
+    mapping_poses = poses(work / f"{profile}-map" / SCANS_BODY_TUM)
+    result = {"map": mapping["map"], "mapping_ape_m": mapping["accuracy"]["ape"]["translation_m"]["rmse"], "passes": {}}
+    curves = {}
+    for seed in pass_seeds:
+        row = {}
+        for mode, maps in (
+            ("odometry", MapOptions()),
+            ("localization", MapOptions(prior_map=work / f"{profile}-map" / MAP_PCD)),
+        ):
+            data = GeneratedDataset(profile, seed, pass_s, work)
+            o = work / f"{profile}-{seed}-{mode}"
+            s = run(data, o, maps)
+            est, gt = poses(o / SCANS_BODY_TUM), poses(data.gt_scans)
+            t, err = error_in_gt_frame(est, gt, mapping_poses if mode == "localization" else est)
+            common = [k for k in sorted(est) if k in mapping_poses]
+            vs_map = np.array([np.linalg.norm(est[k][:3, 3] - mapping_poses[k][:3, 3]) for k in common])
+            t_map = (np.array(common) - common[0]) / 1e9
+            med, p99 = frame_ms(o)
+            row[mode] = {
+                "ape_m": s["accuracy"]["ape"]["translation_m"]["rmse"],
+                "err_end_m": float(err[-1]),
+                "vs_map_end_m": float(vs_map[-1]),
+                "vs_map_max_m": float(vs_map.max()),
+                "frame_ms_median": med,
+                "frame_ms_p99": p99,
+            }
+            if mode == "localization":
+                loc = s["localization"]
+                row[mode] |= {"lost": loc["frames_lost"], "localized": loc["frames_localized"]}
+                import csv
+
+                with open(o / "timing.csv") as f:
+                    row[mode]["min_inlier_fraction"] = min(
+                        float(r["inlier_fraction"]) for r in csv.DictReader(f) if r["inlier_fraction"]
+                    )
+            curves.setdefault(seed, {})[mode] = {"gt": (t, err), "map": (t_map, vs_map)}
+        result["passes"][seed] = row
+    plot_curves(profile, curves, out / f"error_over_time_{profile}.png")
+    return result
+
+
+def plot_curves(profile: str, curves: dict, path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4))
+    for ax, key, title in (
+        (axes[0], "map", "against the map (the mapping run's pose at the same stamp)"),
+        (axes[1], "gt", "against the ground truth (aligned at the start)"),
+    ):
+        for i, (seed, modes) in enumerate(sorted(curves.items())):
+            for mode, style in (("odometry", "--"), ("localization", "-")):
+                t, err = modes[mode][key]
+                ax.plot(t, err, style, color=f"C{i}", label=f"{mode}, seed {seed}")
+        ax.set_xlabel("time [s]")
+        ax.set_ylabel("position error [m]")
+        ax.set_title(title, fontsize=10)
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle(f"{profile}: odometry vs localization in the map of seed {MAP_SEED}")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--profiles", nargs="+", default=["urban", "handheld", "racetrack"], choices=list(DURATIONS_S))
+    ap.add_argument("--pass-seeds", nargs="+", type=int, default=[2, 3])
+    ap.add_argument("--out", type=Path, default=Path("maps_measure"))
+    args = ap.parse_args()
+    args.out.mkdir(parents=True, exist_ok=True)
+    results = {}
+    with tempfile.TemporaryDirectory(prefix="farlio-maps-") as tmp:
+        for profile in args.profiles:
+            r = measure(profile, args.pass_seeds, args.out, Path(tmp))
+            results[profile] = r
+            m = r["map"]
+            print(
+                f"\n{profile}: map {m['points']} points at {m['resolution_m']:.2f} m, "
+                f"{m['memory_bytes'] / 2**20:.1f} MiB, export {m['add_ms_median']:.1f} ms/scan median; "
+                f"mapping run APE {r['mapping_ape_m']:.3f} m"
+            )
+            print(f"{'seed':>4} {'mode':<13} {'APE m':>7} {'err end m':>9} {'vs map end':>10} {'vs map max':>10} "
+                  f"{'lost':>5} {'min inl':>7} {'ms med':>7} {'ms p99':>7}")  # fmt: skip
+            for seed, row in r["passes"].items():
+                for mode, v in row.items():
+                    inliers = v.get("min_inlier_fraction", float("nan"))
+                    print(
+                        f"{seed:>4} {mode:<13} {v['ape_m']:7.3f} {v['err_end_m']:9.3f} {v['vs_map_end_m']:10.3f} "
+                        f"{v['vs_map_max_m']:10.3f} {v.get('lost', ''):>5} {inliers:7.3f} "
+                        f"{v['frame_ms_median']:7.2f} {v['frame_ms_p99']:7.2f}"
+                    )
+            (args.out / "maps.json").write_text(json.dumps(results, indent=2))
+
+
+if __name__ == "__main__":
+    main()
