@@ -93,7 +93,10 @@ class FarlioNode(Node):
         """Declares every parameter (read only: the odometry is built once) and reads them."""
 
         def declare(name: str, default: Any, doc: str) -> Any:
-            dynamic = not isinstance(default, (list, str))  # numbers: -p x:=1 and x:=1.0 both work
+            # numbers and lists of numbers: -p x:=1 and x:=1.0 both work
+            dynamic = not isinstance(default, str) and not (
+                isinstance(default, list) and default and isinstance(default[0], str)
+            )
             descriptor = ParameterDescriptor(description=doc, read_only=True, dynamic_typing=dynamic)
             return self.declare_parameter(name, default, descriptor).value
 

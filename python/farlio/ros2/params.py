@@ -129,8 +129,12 @@ def node_params_from(values: dict[str, Any]) -> NodeParams:
         kind = type(getattr(params, f.name))
         if kind is float and isinstance(value, (int, float)) and not isinstance(value, bool):
             value = float(value)
-        elif kind is list:
-            value = [str(v) for v in value]
+        elif kind is list:  # of the default's element type (names, or numbers given as integers too)
+            element = type(getattr(params, f.name)[0]) if getattr(params, f.name) else str
+            try:
+                value = [element(v) for v in value]
+            except (TypeError, ValueError):
+                raise ValueError(f"parameter {f.name}: expected a list of {element.__name__}, got {value!r}") from None
         elif not isinstance(value, kind):
             raise ValueError(f"parameter {f.name}: expected a {kind.__name__}, got {value!r}")
         setattr(params, f.name, value)
