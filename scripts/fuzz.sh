@@ -16,7 +16,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 FUZZ_SECONDS=${FUZZ_SECONDS:-60}
 JOBS=${JOBS:-$(nproc)}
-ALL_TARGETS="pcd pcd_ascii pcd_binary pcd_compressed ply kitti_bin lzf imu_csv calib_yaml tum kitti_poses times"
+ALL_TARGETS="pcd pcd_ascii pcd_binary pcd_compressed ply kitti_bin lzf imu_csv calib_yaml tum kitti_poses times pointcloud2"
 FUZZ_TARGETS=${FUZZ_TARGETS:-$ALL_TARGETS}
 SHARED_DATA=${FARLIO_SHARED_DATA:-$(cd .. && pwd)/shared/data}
 BUILD=build/fuzz

@@ -1,12 +1,14 @@
 #!/usr/bin/env python3
 """Soak: the LIO over a long generated run in memory (default: 10 km of the racetrack, 2.4 laps at
-up to 70 m/s), with the whole map accumulated as --save-map does. Every --every-s seconds of data
+up to 70 m/s), with the whole map accumulated as --save-map does, through the replay of `farlio
+run` (Odometry, measured latency) or with --online through OnlineOdometry (its worker thread; IMU
+pushed up to each scan's end, then the scan, in lockstep). Every --every-s seconds of data
 it prints the process's resident memory (VmRSS), the submap's bytes and points (bounded by
 map.removal_radius_m), the whole map's cells and bytes (bounded by the mapped volume: flat once a
 lap is mapped), and the frame time so far (median, p99). Memory that keeps growing lap after lap
 is a leak; the whole map and the submap must level off after the first lap.
 
-Usage: python scripts/soak.py [--profile racetrack] [--km 10] [--every-s 10] [--seed 1]
+Usage: python scripts/soak.py [--profile racetrack] [--km 10] [--every-s 10] [--seed 1] [--online]
 """
 
 from __future__ import annotations
@@ -31,6 +33,13 @@ def rss_mib() -> float:
     return float("nan")
 
 
+def submap_mib(odo, online: bool) -> float:
+    """The submap's bytes (the replay reports its backend's; online: its points' bytes)."""
+    if online:
+        return len(odo.map_points()) * 4 * 4 / BYTES_PER_MIB  # approximate: float xyz + pad per point
+    return odo.map_memory_bytes / BYTES_PER_MIB
+
+
 def duration_for(profile: str, km: float) -> float:
     if profile != "racetrack":
         raise SystemExit("--km is for the racetrack; give --duration for other profiles")
@@ -45,6 +54,7 @@ def main() -> None:
     ap.add_argument("--duration", type=float, default=None, help="seconds of data (instead of --km)")
     ap.add_argument("--every-s", type=float, default=10.0)
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--online", action="store_true", help="OnlineOdometry instead of the replay")
     args = ap.parse_args()
     cfg = _core.sim.default_config(args.profile)
     cfg.seed = args.seed
@@ -53,23 +63,38 @@ def main() -> None:
     imu = gen.imu()
     config = _core.Config()
     options = _core.ReplayOptions()  # measured latency, as farlio run
-    odo = _core.Odometry(config, gen.T_imu_lidar(), gen.gravity_m_s2(), imu, options)
+    if args.online:
+        odo = _core.OnlineOdometry(config, gen.T_imu_lidar(), gen.gravity_m_s2())
+    else:
+        odo = _core.Odometry(config, gen.T_imu_lidar(), gen.gravity_m_s2(), imu, options)
     export = None
     frame_ms: list[float] = []
-    print(f"{args.profile} seed {args.seed}: {cfg.duration_s:.0f} s of data, {gen.num_scans()} scans")
+    print(f"{args.profile} seed {args.seed}: {cfg.duration_s:.0f} s of data, {gen.num_scans()} scans, "
+          f"{'OnlineOdometry' if args.online else 'replay (Odometry)'}")  # fmt: skip
     print(f"{'t s':>6} {'RSS MiB':>8} {'submap MiB':>10} {'submap pts':>10} {'map cells':>10} {'map MiB':>8} "
           f"{'ms med':>7} {'ms p99':>7} {'wall s':>7}")  # fmt: skip
     start = time.perf_counter()
     next_report = args.every_s
     t0 = None
+    k = 0  # next IMU sample (online)
     for i in range(gen.num_scans()):
         scan = gen.scan(i)
-        fr = odo.process(scan)
+        if args.online:
+            while k < len(imu) and imu[k].stamp_ns <= scan.end_stamp_ns:
+                odo.add_imu(imu[k])
+                k += 1
+            odo.add_scan(scan)
+            odo.wait_idle()
+            frames = odo.take_frames()
+            fr = frames[-1] if frames else None
+        else:
+            fr = odo.process(scan)
         t0 = scan.end_stamp_ns if t0 is None else t0
-        if fr.processed:
+        if fr is not None and fr.processed:
             frame_ms.append(fr.scan.timings.total_s * MS_PER_S)
             if export is None:
-                effective = odo.effective_config
+                # online: the configured voxel size (the racetrack keeps the 4 m the auto scaling allows)
+                effective = config if args.online else odo.effective_config
                 export = _core.MapExport(_core.export_resolution_m(effective), effective)
             if not fr.scan.failure:
                 export.add(scan, fr.scan)
@@ -79,7 +104,7 @@ def main() -> None:
             next_report += args.every_s
             last = frame_ms[-int(args.every_s * gen.lidar_rate_hz()) :]
             print(
-                f"{t:6.0f} {rss_mib():8.0f} {odo.map_memory_bytes / BYTES_PER_MIB:10.1f} {len(odo.map_points()):10d} "
+                f"{t:6.0f} {rss_mib():8.0f} {submap_mib(odo, args.online):10.1f} {len(odo.map_points()):10d} "
                 f"{export.cells:10d} {export.memory_bytes / BYTES_PER_MIB:8.1f} {np.median(last):7.2f} "
                 f"{np.percentile(last, 99):7.2f} {time.perf_counter() - start:7.0f}",
                 flush=True,

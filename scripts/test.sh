@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Runs every test of farlio: the style check (clang-format, ruff), the C++ tests (ctest), the
-# same C++ tests under AddressSanitizer + UndefinedBehaviorSanitizer, and the Python tests
+# same C++ tests under AddressSanitizer + UndefinedBehaviorSanitizer, the threaded tests (online
+# odometry, replay) under ThreadSanitizer, and the Python tests
 # (pytest) against the installed package, a 5 s fuzz smoke of every file reader (scripts/fuzz.sh),
 # and the ROS 2 node over loopback (tests/ros2, in
 # .venv-ros from scripts/install_ros2.sh; skipped without it). The
@@ -46,4 +47,11 @@ if [ "${FARLIO_SKIP_SANITIZERS:-0}" != 1 ]; then
   cmake --preset asan >/dev/null
   cmake --build --preset asan -j "$JOBS"
   ctest --preset asan
+fi
+
+if [ "${FARLIO_SKIP_TSAN:-0}" != 1 ]; then
+  echo "== Threaded tests under TSan (preset tsan: online odometry, replay) =="
+  cmake --preset tsan >/dev/null
+  cmake --build --preset tsan -j "$JOBS"
+  ctest --preset tsan
 fi

@@ -117,7 +117,8 @@ TEST(OnlineOdometry, LockstepFromTwoThreadsEqualsTheReplay) {
 
 TEST(OnlineOdometry, RealTimeThreadsKeepTheOutputsConsistent) {
   const Recording& rec = recording();
-  const Config config;
+  Config config;
+  config.num_threads = test::kPipelineThreads;
   std::vector<OdometrySample> samples;
   std::atomic<int> processed{0}, dropped{0};
   OnlineOdometry online(
