@@ -8,7 +8,7 @@ map.removal_radius_m), the whole map's cells and bytes (bounded by the mapped vo
 lap is mapped), and the frame time so far (median, p99). Memory that keeps growing lap after lap
 is a leak; the whole map and the submap must level off after the first lap.
 
-Usage: python scripts/soak.py [--profile racetrack] [--km 10] [--every-s 10] [--seed 1] [--online]
+Usage: python scripts/soak.py [--profile racetrack] [--km 10] [--every-s 10] [--seed 1] [--online] [--no-map]
 """
 
 from __future__ import annotations
@@ -55,6 +55,7 @@ def main() -> None:
     ap.add_argument("--every-s", type=float, default=10.0)
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--online", action="store_true", help="OnlineOdometry instead of the replay")
+    ap.add_argument("--no-map", action="store_true", help="without the whole map (the odometry's memory alone)")
     args = ap.parse_args()
     cfg = _core.sim.default_config(args.profile)
     cfg.seed = args.seed
@@ -92,11 +93,11 @@ def main() -> None:
         t0 = scan.end_stamp_ns if t0 is None else t0
         if fr is not None and fr.processed:
             frame_ms.append(fr.scan.timings.total_s * MS_PER_S)
-            if export is None:
+            if export is None and not args.no_map:
                 # online: the configured voxel size (the racetrack keeps the 4 m the auto scaling allows)
                 effective = config if args.online else odo.effective_config
                 export = _core.MapExport(_core.export_resolution_m(effective), effective)
-            if not fr.scan.failure:
+            if export is not None and not fr.scan.failure:
                 export.add(scan, fr.scan)
         odo.take_odometry()
         t = (scan.end_stamp_ns - t0) / 1e9
@@ -105,7 +106,8 @@ def main() -> None:
             last = frame_ms[-int(args.every_s * gen.lidar_rate_hz()) :]
             print(
                 f"{t:6.0f} {rss_mib():8.0f} {submap_mib(odo, args.online):10.1f} {len(odo.map_points()):10d} "
-                f"{export.cells:10d} {export.memory_bytes / BYTES_PER_MIB:8.1f} {np.median(last):7.2f} "
+                f"{export.cells if export else 0:10d} {export.memory_bytes / BYTES_PER_MIB if export else 0:8.1f} "
+                f"{np.median(last):7.2f} "
                 f"{np.percentile(last, 99):7.2f} {time.perf_counter() - start:7.0f}",
                 flush=True,
             )

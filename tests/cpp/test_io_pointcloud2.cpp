@@ -279,6 +279,16 @@ TEST(PointCloud2, EmptyCloudAndDuplicateNames) {
   EXPECT_EQ(dup.decode().points.at(0).x(), 4.0f);
 }
 
+TEST(PointCloud2, AnEmptyCloudWithAHugeRowStepReadsNothing) {
+  // found by fuzz_pointcloud2: width 0, two rows 2^63 - 255 bytes apart, no data passed the size
+  // check and the row pointer was advanced past the data (undefined behaviour under UBSan)
+  Cloud wide(xyz_and({{"t", PointFieldType::Uint32}}), 0, 2);
+  wide.layout.row_step = std::numeric_limits<std::int64_t>::max() - 254;
+  wide.data.clear();
+  const auto d = wide.decode(time_request("t", 1));
+  EXPECT_TRUE(d.points.empty() && d.offset_s.empty());
+}
+
 TEST(PointCloud2, BadLayoutsAreClearErrors) {
   const auto xyz_t = [] { return Cloud(xyz_and({{"t", PointFieldType::Uint32}}), 4, 2); };
   Cloud no_z({{"x", PointFieldType::Float32}, {"y", PointFieldType::Float32}, {"t", PointFieldType::Float32}}, 2);

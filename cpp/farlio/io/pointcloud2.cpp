@@ -261,6 +261,9 @@ Rows check_rows(const PointCloud2Layout& layout, std::span<const std::uint8_t> d
                      (overflow ? std::string("more than can be addressed") : std::to_string(needed)) + " (row_step " +
                      std::to_string(row_step) + ", point_step " + std::to_string(layout.point_step) + "; truncated?)");
   }
+  // an empty cloud has no rows: a row_step past the data must not even be added to its pointer
+  // (fuzz_pointcloud2: width 0, height 2, row_step 2^63 - 255 passed the size check)
+  if (layout.width == 0 || layout.height == 0) return Rows{data.data(), 0, 0, 0, 0};
   return Rows{data.data(), static_cast<std::size_t>(layout.width), static_cast<std::size_t>(layout.height),
               static_cast<std::size_t>(layout.point_step), static_cast<std::size_t>(row_step)};
 }
