@@ -1,5 +1,6 @@
 // Bindings of the parameter set and the scan pipeline.
 #include <nanobind/eigen/dense.h>
+#include <nanobind/stl/filesystem.h>
 #include <nanobind/stl/optional.h>
 #include <nanobind/stl/pair.h>
 #include <nanobind/stl/string.h>
@@ -14,6 +15,7 @@
 #include "bindings.hpp"
 #include "farlio/core/clock_check.hpp"
 #include "farlio/core/config_fields.hpp"
+#include "farlio/io/point_stream_writer.hpp"
 #include "farlio/pipeline/map_export.hpp"
 #include "farlio/pipeline/odometry.hpp"
 #include "farlio/pipeline/online_odometry.hpp"
@@ -357,14 +359,17 @@ void bind_pipeline(nb::module_& m) {
         "pass the effective config)");
   nb::class_<pipeline::MapExport>(m, "MapExport",
                                   "The whole map of a run: every used scan, undistorted, at its pose, one centroid "
-                                  "(with the mean intensity) per cell of resolution_m; memory grows with the mapped "
-                                  "volume, not the run's length.")
+                                  "(with the mean intensity) per cell of resolution_m; with a spill folder only the "
+                                  "tiles around the sensor stay in memory.")
       .def(
           "__init__",
-          [](pipeline::MapExport* self, double resolution_m, const Config& config) {
-            new (self) pipeline::MapExport(resolution_m, config.preprocess, config.num_threads);
+          [](pipeline::MapExport* self, double resolution_m, const Config& config, const std::string& spill_dir) {
+            new (self) pipeline::MapExport(resolution_m, config.preprocess, config.num_threads, spill_dir,
+                                           config.map.export_tile_m);
           },
-          "resolution_m"_a, "config"_a)
+          "resolution_m"_a, "config"_a, "spill_dir"_a = "",
+          "spill_dir: a folder where tiles of map.export_tile_m the sensor has left wait until the end "
+          "(memory bounded by the tiles around the sensor); '': all in memory")
       .def(
           "add",
           [](pipeline::MapExport& e, const Scan& scan, const pipeline::FrameResult& r) {
@@ -373,8 +378,23 @@ void bind_pipeline(nb::module_& m) {
           "scan"_a, "result"_a, nb::call_guard<nb::gil_scoped_release>(),
           "Adds a processed scan at its pose with the motion it was undistorted with; returns the points added.")
       .def("points", &pipeline::MapExport::points, nb::call_guard<nb::gil_scoped_release>(),
-           "The map as a Scan: one point per cell (centroid, mean intensity), ordered by cell.")
+           "The whole map as one Scan (in memory): one point per cell (centroid, mean intensity).")
+      .def(
+          "write",
+          [](const pipeline::MapExport& e, const std::vector<std::filesystem::path>& paths) {
+            std::vector<io::PointStreamWriter> writers;
+            writers.reserve(paths.size());
+            for (const auto& p : paths) writers.emplace_back(p, e.cells());
+            e.for_each_piece([&](std::span<const Vec3f> points, std::span<const float> intensity) {
+              for (auto& w : writers) w.append(points, intensity);
+            });
+            for (auto& w : writers) w.close();
+          },
+          "paths"_a, nb::call_guard<nb::gil_scoped_release>(),
+          "Streams the whole map, tile by tile, into each file (.pcd binary or .ply binary; x y z intensity).")
       .def_prop_ro("cells", &pipeline::MapExport::cells)
+      .def_prop_ro("cells_in_memory", &pipeline::MapExport::cells_in_memory)
+      .def_prop_ro("tiles_on_disk", &pipeline::MapExport::tiles_on_disk)
       .def_prop_ro("points_added", &pipeline::MapExport::points_added)
       .def_prop_ro("resolution_m", &pipeline::MapExport::resolution_m)
       .def_prop_ro("memory_bytes", &pipeline::MapExport::memory_bytes);

@@ -2,8 +2,10 @@
 localization in a prior map with --prior-map (the map's frame is the world frame of the run).
 
 The whole map is accumulated as the run goes (_core.MapExport: every scan whose pose was used,
-undistorted, at its registered pose, one centroid per cell of the export resolution), so its memory
-grows with the mapped volume, not with the run's length; it is written at the end of the run."""
+undistorted, at its registered pose, one centroid per cell of the export resolution); only the
+tiles (map.export_tile_m) the sensor can reach stay in memory, the others wait in the output
+folder's .map_tiles/ until the end of the run, when the map is streamed into map.pcd and map.ply
+tile by tile."""
 
 from __future__ import annotations
 
@@ -20,6 +22,8 @@ import farlio
 from farlio import _core
 
 MAP_PLY, MAP_PCD = "map.ply", "map.pcd"
+#: where the whole map's tiles the sensor has left wait during a run (removed at its end)
+SPILL_DIR = ".map_tiles"
 MS_PER_S = 1e3
 #: --initial-pose: X Y Z in metres, ROLL PITCH YAW in degrees
 INITIAL_POSE_VALUES = 6
@@ -70,10 +74,12 @@ def load_prior_map(odo: Any, options: MapOptions) -> int:
 class WholeMap:
     """The whole map of a run under construction (--save-map) and its files."""
 
-    def __init__(self, resolution_m: float | None):
+    def __init__(self, resolution_m: float | None, out_dir: Path):
         self.requested_resolution_m = resolution_m
+        self.spill_dir = Path(out_dir) / SPILL_DIR
         self.export: Any = None
         self.add_ms: list[float] = []
+        self.most_cells_in_memory = 0
 
     def add(self, odo: Any, scan: Any, frame: Any) -> None:
         """A processed scan whose pose was used (not a failure, not lost in a prior map)."""
@@ -84,27 +90,34 @@ class WholeMap:
             config = odo.effective_config
             if self.requested_resolution_m is not None:
                 config.set("map.export_resolution_m", self.requested_resolution_m)
-            self.export = _core.MapExport(_core.export_resolution_m(config), config)
+            self.export = _core.MapExport(_core.export_resolution_m(config), config, str(self.spill_dir))
         start = time.perf_counter()
         self.export.add(scan, r)
         self.add_ms.append((time.perf_counter() - start) * MS_PER_S)
+        self.most_cells_in_memory = max(self.most_cells_in_memory, self.export.cells_in_memory)
 
     def write(self, out_dir: Path, trajectory: Path, plot: bool) -> dict[str, Any]:
-        """map.pcd and map.ply (x y z intensity, world frame) and map.png; returns the summary's
-        "map" entry (cells, resolution, memory, time per scan)."""
-        points = self.export.points() if self.export is not None else farlio.Scan(np.zeros((0, 3), np.float32))
-        _core.io.write_pcd(out_dir / MAP_PCD, points)
-        _core.io.write_ply(out_dir / MAP_PLY, points)
+        """map.pcd and map.ply (x y z intensity, world frame), streamed tile by tile, and map.png;
+        returns the summary's "map" entry (cells, resolution, memory, time per scan)."""
+        e = self.export
+        if e is not None:
+            e.write([out_dir / MAP_PCD, out_dir / MAP_PLY])
+        else:  # no scan was used: empty files
+            empty = farlio.Scan(np.zeros((0, 3), np.float32))
+            _core.io.write_pcd(out_dir / MAP_PCD, empty)
+            _core.io.write_ply(out_dir / MAP_PLY, empty)
         if plot:
             from .plots import MAP_PNG, plot_map
 
-            plot_map(np.asarray(points.points), trajectory, out_dir / MAP_PNG)
-        e = self.export
-        return {
-            "points": len(points),
+            plot_map(np.asarray(_core.io.read_point_cloud(out_dir / MAP_PCD).points), trajectory, out_dir / MAP_PNG)
+        summary = {
+            "points": e.cells if e else 0,
             "resolution_m": e.resolution_m if e else None,
             "points_added": e.points_added if e else 0,
+            "most_cells_in_memory": self.most_cells_in_memory,
             "memory_bytes": e.memory_bytes if e else 0,
             "add_ms_median": float(np.median(self.add_ms)) if self.add_ms else None,
             "add_ms_p99": float(np.percentile(self.add_ms, 99)) if self.add_ms else None,
         }
+        self.export = None  # removes the tiles' files and the folder
+        return summary

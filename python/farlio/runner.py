@@ -136,7 +136,7 @@ class OdometryRun:
     def __init__(self, dataset: Dataset, out_dir: Path, config: Any, maps: MapOptions | None = None):
         self.dataset, self.out_dir, self.config = dataset, out_dir, config
         self.maps = maps or MapOptions()
-        self.whole_map = WholeMap(self.maps.resolution_m) if self.maps.save else None
+        self.whole_map = WholeMap(self.maps.resolution_m, out_dir) if self.maps.save else None
         self.prior_map_points = 0
         self.frames = 0
         self.counts = FrameCounts()

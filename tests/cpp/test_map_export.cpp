@@ -1,7 +1,10 @@
 // The whole-map export (pipeline/map_export.hpp) against a brute-force voxel centroid.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <map>
 
@@ -129,4 +132,63 @@ TEST(MapExport, ExportResolutionDefaultsToThePointSpacing) {
   EXPECT_DOUBLE_EQ(pipeline::export_resolution_m(c), 1.0);
   c.map.export_resolution_m = 0.2;
   EXPECT_DOUBLE_EQ(pipeline::export_resolution_m(c), 0.2);
+}
+
+namespace {
+
+/// The scene around a sensor (sensor frame): what every pose below sees of its own surroundings.
+Scan local_scan() {
+  Scan s;
+  for (const auto& p : test::sample_scene(20000, 11, 0.0f)) {
+    s.points.push_back(p);
+    s.intensity.push_back(p.z());
+  }
+  return s;
+}
+
+/// The points of a map as a sorted list of (x, y, z, intensity).
+std::vector<std::array<float, 4>> sorted_points(const Scan& s) {
+  std::vector<std::array<float, 4>> out;
+  for (std::size_t i = 0; i < s.size(); ++i)
+    out.push_back({s.points[i].x(), s.points[i].y(), s.points[i].z(), s.intensity[i]});
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+}  // namespace
+
+TEST(MapExport, TilesLeftBehindWaitOnDiskAndComeBack) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "farlio_test_map_tiles";
+  std::filesystem::remove_all(dir);
+  PreprocessConfig crop;
+  crop.max_range_m = 20.0;  // a tile of 10 m is within reach up to 28.7 m, spilled beyond 38.7 m
+  const Scan scan = local_scan();
+  const auto at = [](double x) { return SE3(Eigen::Quaterniond::Identity(), Eigen::Vector3d(x, 0.0, 0.0)); };
+  {
+    pipeline::MapExport spilling(kResolution_m, crop, 0, dir, 10.0);
+    pipeline::MapExport all(kResolution_m, crop);
+    for (const double x : {0.0, 100.0, 200.0}) {
+      spilling.add(scan, deskew::ScanMotion{}, false, at(x));
+      all.add(scan, deskew::ScanMotion{}, false, at(x));
+    }
+    EXPECT_EQ(spilling.cells(), all.cells());
+    EXPECT_GT(spilling.tiles_on_disk(), 0u);
+    EXPECT_LT(spilling.cells_in_memory(), spilling.cells() / 2);  // two of the three places are on disk
+    EXPECT_LT(spilling.memory_bytes(), all.memory_bytes());
+    EXPECT_FALSE(std::filesystem::is_empty(dir));
+    // back at the start: its tiles come back before the points are added, and the revisit adds no cell
+    const std::size_t cells = spilling.cells();
+    spilling.add(scan, deskew::ScanMotion{}, false, at(0.0));
+    all.add(scan, deskew::ScanMotion{}, false, at(0.0));
+    EXPECT_EQ(spilling.cells(), cells);
+    // the same map either way: every cell once, with the same sums
+    EXPECT_EQ(sorted_points(spilling.points()), sorted_points(all.points()));
+    std::size_t streamed = 0;
+    spilling.for_each_piece([&](std::span<const Vec3f> p, std::span<const float> i) {
+      EXPECT_EQ(p.size(), i.size());
+      streamed += p.size();
+    });
+    EXPECT_EQ(streamed, cells);
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir));  // the tiles' files and the folder are removed
 }

@@ -52,37 +52,40 @@ inline constexpr double kMaxThreads = 1024.0;
   FIELD(bool, undistort, true, range::unchecked(), "motion undistortion (MU) of points with per-point times")
 
 // ---- map: the voxel hash map (the paper's cuVoxelMap), the adaptive local submap ----------------
-#define FARLIO_MAP_FIELDS(FIELD)                                                                          \
-  FIELD(double, voxel_size_m, 4.0, range::between(kMinVoxelSize_m, kMaxVoxelSize_m),                      \
-        "v: edge of a voxel cube (paper: 4 m); the upper bound when auto_voxel_size")                     \
-  FIELD(bool, auto_voxel_size, true, range::unchecked(),                                                  \
-        "scale the voxel to the scene at the first scan: v = clamp(p90 range / auto_range_ratio, "        \
-        "auto_min_voxel_size_m, voxel_size_m); vehicles outdoors keep 4 m, rooms get a finer map")        \
-  FIELD(double, auto_range_ratio, 6.0, range::positive_up_to(kMaxRatio),                                  \
-        "p90 range of the first scan over the voxel size (auto)")                                         \
-  FIELD(double, auto_min_voxel_size_m, 1.0, range::between(kMinVoxelSize_m, kMaxVoxelSize_m),             \
-        "smallest voxel the auto scaling picks")                                                          \
-  FIELD(int, max_points_per_voxel, 40, range::between(1, kMaxPointsPerVoxel),                             \
-        "N_max: points a voxel holds at most (paper: 40)")                                                \
-  FIELD(double, point_spacing_m, 0.0, range::non_negative_up_to(kMaxVoxelSize_m),                         \
-        "minimum distance between points of a voxel; 0: voxel_size_m / sqrt(N_max) (0.63 m at 4 m)")      \
-  FIELD(int, covariance_neighbors, 10, range::between(1, kMaxCovarianceNeighbors),                        \
-        "k nearest neighbours of a point covariance (paper: 10)")                                         \
-  FIELD(double, covariance_epsilon, 1e-3, range::positive_up_to(kMaxSiValue),                             \
-        "eps of the Frobenius regularisation: C = Sigma_hat + eps I, eq. (1)")                            \
-  FIELD(double, line_eigenvalue_ratio, 10.0, range::non_negative_up_to(kMaxRatio),                        \
-        "a covariance is line-like (a scan line, a pole) when, regularised, its middle eigenvalue is "    \
-        "below ratio x the smallest while the largest is above it; 0: never (all surfaces)")              \
-  FIELD(double, removal_radius_m, 1000.0, range::positive_up_to_or_inf(kMaxDistance_m),                   \
-        "voxels whose centre is farther than this from the pose are removed (inf: never)")                \
-  FIELD(bool, refresh_covariances, true, range::unchecked(),                                              \
-        "recompute the covariances of existing points in voxels that receive new points "                 \
-        "(the reference never refreshes them)")                                                           \
-  FIELD(double, export_resolution_m, 0.0, range::non_negative_up_to(kMaxVoxelSize_m),                     \
-        "cell of the whole map farlio run --save-map writes (one centroid a cell); 0: the point spacing") \
-  FIELD(std::int64_t, initial_voxel_capacity, 1 << 14, range::between(1, kMaxVoxelCapacity),              \
-        "voxels preallocated; the pool doubles as needed")                                                \
-  FIELD(std::int64_t, max_voxel_capacity, 1 << 20, range::between(1, kMaxVoxelCapacity),                  \
+#define FARLIO_MAP_FIELDS(FIELD)                                                                              \
+  FIELD(double, voxel_size_m, 4.0, range::between(kMinVoxelSize_m, kMaxVoxelSize_m),                          \
+        "v: edge of a voxel cube (paper: 4 m); the upper bound when auto_voxel_size")                         \
+  FIELD(bool, auto_voxel_size, true, range::unchecked(),                                                      \
+        "scale the voxel to the scene at the first scan: v = clamp(p90 range / auto_range_ratio, "            \
+        "auto_min_voxel_size_m, voxel_size_m); vehicles outdoors keep 4 m, rooms get a finer map")            \
+  FIELD(double, auto_range_ratio, 6.0, range::positive_up_to(kMaxRatio),                                      \
+        "p90 range of the first scan over the voxel size (auto)")                                             \
+  FIELD(double, auto_min_voxel_size_m, 1.0, range::between(kMinVoxelSize_m, kMaxVoxelSize_m),                 \
+        "smallest voxel the auto scaling picks")                                                              \
+  FIELD(int, max_points_per_voxel, 40, range::between(1, kMaxPointsPerVoxel),                                 \
+        "N_max: points a voxel holds at most (paper: 40)")                                                    \
+  FIELD(double, point_spacing_m, 0.0, range::non_negative_up_to(kMaxVoxelSize_m),                             \
+        "minimum distance between points of a voxel; 0: voxel_size_m / sqrt(N_max) (0.63 m at 4 m)")          \
+  FIELD(int, covariance_neighbors, 10, range::between(1, kMaxCovarianceNeighbors),                            \
+        "k nearest neighbours of a point covariance (paper: 10)")                                             \
+  FIELD(double, covariance_epsilon, 1e-3, range::positive_up_to(kMaxSiValue),                                 \
+        "eps of the Frobenius regularisation: C = Sigma_hat + eps I, eq. (1)")                                \
+  FIELD(double, line_eigenvalue_ratio, 10.0, range::non_negative_up_to(kMaxRatio),                            \
+        "a covariance is line-like (a scan line, a pole) when, regularised, its middle eigenvalue is "        \
+        "below ratio x the smallest while the largest is above it; 0: never (all surfaces)")                  \
+  FIELD(double, removal_radius_m, 1000.0, range::positive_up_to_or_inf(kMaxDistance_m),                       \
+        "voxels whose centre is farther than this from the pose are removed (inf: never)")                    \
+  FIELD(bool, refresh_covariances, true, range::unchecked(),                                                  \
+        "recompute the covariances of existing points in voxels that receive new points "                     \
+        "(the reference never refreshes them)")                                                               \
+  FIELD(double, export_resolution_m, 0.0, range::non_negative_up_to(kMaxVoxelSize_m),                         \
+        "cell of the whole map farlio run --save-map writes (one centroid a cell); 0: the point spacing")     \
+  FIELD(double, export_tile_m, 64.0, range::between(1.0, kMaxDistance_m),                                     \
+        "the whole map keeps in memory the tiles of this edge the sensor can reach; the others wait on disk " \
+        "beside the outputs until the end of the run")                                                        \
+  FIELD(std::int64_t, initial_voxel_capacity, 1 << 14, range::between(1, kMaxVoxelCapacity),                  \
+        "voxels preallocated; the pool doubles as needed")                                                    \
+  FIELD(std::int64_t, max_voxel_capacity, 1 << 20, range::between(1, kMaxVoxelCapacity),                      \
         "hard limit of the submap in voxels: growth beyond it is a CapacityError")
 
 // ---- density: adaptive submap density (ASMD), the per-voxel limit follows the scan's density ---

@@ -6,6 +6,7 @@
 #include "farlio/core/error.hpp"
 #include "farlio/io/file_bytes.hpp"
 #include "farlio/io/point_cloud_io.hpp"
+#include "farlio/io/point_stream_writer.hpp"
 
 namespace farlio::io {
 
@@ -17,10 +18,7 @@ void write_ply(const std::filesystem::path& path, const std::vector<Vec3f>& poin
     throw InputError(path.string() + ": " + std::to_string(intensity->size()) + " intensities for " +
                      std::to_string(points.size()) + " points");
   }
-  std::string header = "ply\nformat binary_little_endian 1.0\ncomment written by farlio\nelement vertex " +
-                       std::to_string(points.size()) + "\nproperty float x\nproperty float y\nproperty float z\n";
-  if (with_intensity) header += "property float intensity\n";
-  header += "end_header\n";
+  const std::string header = ply_vertex_header(points.size(), with_intensity);
   Bytes out(header.begin(), header.end());
   const std::size_t point_bytes = sizeof(Vec3f) + (with_intensity ? sizeof(float) : 0);
   out.reserve(out.size() + points.size() * point_bytes);
