@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # One command from a fresh Debian 12 checkout to a result: installs every dependency (Debian
 # packages, PyPI into .venv), builds and installs the farlio Python package, generates 45 s of
-# the urban drive with exact ground truth (the embedded default: 600 m through a street grid with
-# stops and a turn; ~1 GB of scans) and runs the LiDAR-inertial odometry on it, printing latency
+# the urban drive with exact ground truth (the embedded default: about 430 m down a street and
+# round a corner; 1.1 GB of scans) and runs the LiDAR-inertial odometry on it, printing latency
 # and accuracy, and saves the whole map. Outputs: out/demo/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
