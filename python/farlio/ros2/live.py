@@ -61,7 +61,6 @@ class Counters:
     clouds_out_of_order: int = 0
     clouds_undecodable: int = 0
     clouds_empty: int = 0
-    scans_bad_times: int = 0
     points_non_finite: int = 0
     scans: int = 0
     scans_before_imu: int = 0
@@ -245,11 +244,6 @@ class LiveOdometry:
             self.report("points_non_finite", f"{self.topics[0]}: {removed} points with NaN/Inf dropped")
         if len(scan) == 0:
             self.report("clouds_empty", f"{self.topics[0]}: scan ending {scan.end_stamp_ns} ns has no point: dropped")
-            return
-        try:  # the check of every loader (farlio._core.io.check_point_times)
-            farlio._core.io.check_point_times(scan, f"{self.topics[0]}: scan ending {scan.end_stamp_ns} ns")
-        except ValueError as e:
-            self.report("scans_bad_times", f"{e}: dropped")
             return
         if not self._imu_ready(arrival):
             return
