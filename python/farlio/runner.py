@@ -247,14 +247,10 @@ class OdometryRun:
 
     def next_scan(self, i: int) -> Any:
         """Scan i without non-finite points; None (counted as skipped, with a warning) when it
-        cannot be read, its per-point times are not seconds since its start, or it does not come
-        after the previous one."""
+        cannot be read (the loaders also refuse per-point times that are not seconds since the
+        scan start) or does not come after the previous one."""
         try:
             scan = self.dataset.scan(i)
-            # per-point times that cannot be seconds since the scan start (a unit read wrong, times
-            # past the scan): the check every loader shares, here for those that do not run it
-            # themselves (bags, Ouster, datasets from Python)
-            _core.io.check_point_times(scan, "the scan")
         except (ValueError, OSError) as e:
             self.counts.skipped += 1
             _warn(f"skipping {self.dataset.scan_source(i)}: {e}")

@@ -253,13 +253,15 @@ def test_extrinsic_chain_and_calib_file(tmp_path):
 
 def test_per_point_times_past_the_scan_are_skipped_by_farlio_run(tmp_path, capsys):
     """Times that reach 5 periods (0.5 s of a 0.1 s scan: within the decoder's 1 s span rule) fail
-    the check every loader shares (check_point_times), which `farlio run` applies to bag scans."""
+    the check every loader shares (check_point_times), which the bag loader runs on its scans:
+    `farlio run` skips them with a warning."""
     from farlio.cli import main as cli
 
     bag = small_bag(tmp_path / "t.bag", times=np.linspace(0.0, 0.5, 50), convention="velodyne")
     assert cli(["run", str(bag), "--out", str(tmp_path / "out"), "--no-progress", "--no-plot"]) == 0
     err = capsys.readouterr().err
     assert "skipping t.bag" in err or "skipping " + str(bag) in err, err
-    assert err.count(": the scan: per-point times") == 3, err  # all three clouds: 0.5 s in a 0.1 s period
+    # all three clouds: their times (0.5 s in a 0.1 s period) reach back before the scan start
+    assert err.count(": per-point times start at -0.1 s, before the scan start") == 3, err
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert summary["skipped"] == summary["frames"] == 3

@@ -260,7 +260,9 @@ class OusterRecording(Dataset):
             if frame is None:
                 raise ValueError(f"{self.path}: only {self._next} frames (scan {i} asked)")
             self._next += 1
-        return self._to_scan(frame)
+        scan = self._to_scan(frame)
+        farlio._core.io.check_point_times(scan, self.scan_source(i))  # the check of every loader
+        return scan
 
     def scan_source(self, i: int) -> str:
         return f"{self.path} frame {i}"

@@ -293,6 +293,7 @@ class RosBag(Dataset):
             self._next += 1
         if isinstance(item, Exception):
             raise item
+        farlio._core.io.check_point_times(item, self.scan_source(i))  # the check of every loader
         return item
 
     # --- the sequential pass ---------------------------------------------------------------------
