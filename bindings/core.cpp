@@ -12,6 +12,7 @@
 #include "farlio/core/time.hpp"
 #include "farlio/core/trajectory.hpp"
 #include "farlio/core/types.hpp"
+#include "farlio/fusion/euler.hpp"
 #include "repr.hpp"
 
 namespace nb = nanobind;
@@ -118,6 +119,8 @@ void bind_core(nb::module_& m) {
       .def_rw("accel_m_s2", &ImuSample::accel_m_s2)
       .def("__repr__", attribute_repr({"stamp_ns", "gyro_rad_s", "accel_m_s2"}));
 
+  m.def("rotation_from_euler", &fusion::rotation_from_euler, "rpy_rad"_a,
+        "Rotation matrix (body -> world) of [roll, pitch, yaw] in radians: Rz(yaw) Ry(pitch) Rx(roll).");
   nb::class_<SE3>(m, "SE3", "Rigid transform; tangent vectors are [translation; rotation].")
       .def(nb::init<>())
       .def_static("from_matrix", &SE3::from_matrix, "m"_a)

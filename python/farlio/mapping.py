@@ -45,14 +45,9 @@ def pose_from_xyz_rpy_deg(values: Sequence[float]) -> Any:
     """The SE3 of X Y Z (m) and ROLL PITCH YAW (deg), R = Rz(yaw) Ry(pitch) Rx(roll)."""
     if len(values) != INITIAL_POSE_VALUES or not all(math.isfinite(v) for v in values):
         raise ValueError(f"an initial pose is X Y Z ROLL PITCH YAW (6 finite numbers), got {list(values)}")
-    x, y, z, roll, pitch, yaw = (float(v) for v in values)
-    r, p, w = np.radians([roll, pitch, yaw])
-    rx = np.array([[1, 0, 0], [0, math.cos(r), -math.sin(r)], [0, math.sin(r), math.cos(r)]])
-    ry = np.array([[math.cos(p), 0, math.sin(p)], [0, 1, 0], [-math.sin(p), 0, math.cos(p)]])
-    rz = np.array([[math.cos(w), -math.sin(w), 0], [math.sin(w), math.cos(w), 0], [0, 0, 1]])
     m = np.eye(4)
-    m[:3, :3] = rz @ ry @ rx
-    m[:3, 3] = (x, y, z)
+    m[:3, :3] = _core.rotation_from_euler(np.radians(np.asarray(values[3:], dtype=np.float64)))
+    m[:3, 3] = values[:3]
     return _core.SE3.from_matrix(m)
 
 
