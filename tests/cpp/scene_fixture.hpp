@@ -2,8 +2,13 @@
 // A small synthetic structured scene (floor, walls, boxes, a pole, a ramp) sampled at random,
 // for registration tests with an exactly known transform.
 #include <Eigen/Core>
+#include <cmath>
+#include <cstdint>
 #include <random>
 #include <vector>
+
+#include "farlio/core/se3.hpp"
+#include "farlio/core/types.hpp"
 
 namespace farlio::test {
 
@@ -48,6 +53,17 @@ inline std::vector<Eigen::Vector3f> sample_scene(std::size_t n, unsigned seed, f
     pts.push_back(p);
   }
   return pts;
+}
+
+/// A scan of the scene (n points sampled with `seed`, `noise_m`) seen from `pose`, ending at end_s
+/// after period_s; no per-point times.
+inline Scan scene_scan(const SE3& pose, double end_s, double period_s, std::size_t n, unsigned seed, float noise_m) {
+  const SE3 inv = pose.inverse();
+  Scan s;
+  s.end_stamp_ns = static_cast<std::int64_t>(std::llround(end_s * 1e9));
+  s.start_stamp_ns = s.end_stamp_ns - static_cast<std::int64_t>(std::llround(period_s * 1e9));
+  for (const auto& p : sample_scene(n, seed, noise_m)) s.points.push_back((inv * p.cast<double>()).cast<float>());
+  return s;
 }
 
 }  // namespace farlio::test

@@ -135,13 +135,22 @@ TEST(Sequence, LoneScanStartUsesMaxTime) {
   EXPECT_EQ(back.start_stamp_ns, 5'000'000'000 - std::llround(0.25f * 1e9));
 }
 
-TEST(Sequence, ImuBackwardsSampleDroppedWithWarning) {
-  TempDir tmp;
-  SequenceWriter w(tmp.path());
+namespace {
+
+/// A sequence folder with calib.yaml and one scan (ending at 100 ns), for the imu.csv beside them.
+void write_folder_with_one_scan(const std::filesystem::path& dir) {
+  SequenceWriter w(dir);
   w.write_calibration(Calibration{});
   Scan s = test::random_scan(10, 1);
   s.end_stamp_ns = 100;
   w.write_scan(s);
+}
+
+}  // namespace
+
+TEST(Sequence, ImuBackwardsSampleDroppedWithWarning) {
+  TempDir tmp;
+  write_folder_with_one_scan(tmp.path());
   test::write_raw(tmp.path() / "imu.csv",
                   "ax,ay,az,t_ns,gx,gy,gz,temp_c\n"
                   "0,0,9.81,1000,0.1,0.2,0.3,25\n"
@@ -166,11 +175,7 @@ TEST(Sequence, ImuNonFiniteSamplesDroppedWithWarnings) {
   // a sensor's NaN or inf drops its sample (named), the run goes on; text that is no number stays
   // an error naming the line
   TempDir tmp;
-  SequenceWriter w(tmp.path());
-  w.write_calibration(Calibration{});
-  Scan s = test::random_scan(10, 1);
-  s.end_stamp_ns = 100;
-  w.write_scan(s);
+  write_folder_with_one_scan(tmp.path());
   std::string csv = "t_ns,gx,gy,gz,ax,ay,az\n";
   for (int k = 1; k <= 20; ++k) {
     const bool bad = k % 4 == 0 || k > 14;  // 4, 8, 12, 15..20: 9 samples

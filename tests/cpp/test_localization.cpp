@@ -21,14 +21,7 @@ SE3 truth_at(double t) {
 
 Scan make_scan(int k) {
   const double t = (k + 1) * kPeriod_s;
-  const SE3 inv = truth_at(t).inverse();
-  Scan s;
-  s.end_stamp_ns = static_cast<std::int64_t>(std::llround(t * 1e9));
-  s.start_stamp_ns = s.end_stamp_ns - static_cast<std::int64_t>(std::llround(kPeriod_s * 1e9));
-  for (const auto& p : test::sample_scene(60000, 500 + static_cast<unsigned>(k), 0.01f)) {
-    s.points.push_back((inv * p.cast<double>()).cast<float>());
-  }
-  return s;
+  return test::scene_scan(truth_at(t), t, kPeriod_s, 60000, 500 + static_cast<unsigned>(k), 0.01f);
 }
 
 Config test_config() {
