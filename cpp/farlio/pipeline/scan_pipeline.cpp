@@ -51,6 +51,19 @@ SE3 ScanPipeline::predict(std::int64_t stamp_ns) const {
   return last_pose_ * SE3::exp(last_twist() * dt);
 }
 
+bool ScanPipeline::restart_map_after_failures(std::int64_t stamp_ns, const FrameResult& result) {
+  if (result.failure.empty()) {
+    failing_since_ns_.reset();
+    return false;
+  }
+  if (!failing_since_ns_) failing_since_ns_ = stamp_ns;
+  const double failing_s = ns_to_seconds(stamp_ns - *failing_since_ns_);
+  if (result.kept_points == 0 || failing_s < config_.registration.map_restart_after_s) return false;
+  backend_->reset(config_);
+  failing_since_ns_.reset();
+  return true;
+}
+
 FrameResult ScanPipeline::process(const Scan& scan, const std::optional<SE3>& initial_guess,
                                   const std::optional<deskew::ScanMotion>& motion) {
   auto t_start = Clock::now();
@@ -147,21 +160,11 @@ FrameResult ScanPipeline::process(const Scan& scan, const std::optional<SE3>& in
   // from this scan at the prediction (recovery when the old map no longer matches). A prior
   // map (localization) is held fixed.
   t0 = Clock::now();
-  if (localizing()) {
-    // nothing changes the map
-  } else if (out.failure.empty()) {
-    failing_since_ns_.reset();
-  } else {
-    if (!failing_since_ns_) failing_since_ns_ = scan.end_stamp_ns;
-    const double failing_s = ns_to_seconds(scan.end_stamp_ns - *failing_since_ns_);
-    if (out.kept_points > 0 && failing_s >= config_.registration.map_restart_after_s) {
-      backend_->reset(config_);
-      out.map_restarted = true;
-      failing_since_ns_.reset();
-    }
+  if (!localizing()) {
+    out.map_restarted = restart_map_after_failures(scan.end_stamp_ns, out);
+    if (out.failure.empty() || out.map_restarted)
+      out.map_insert = backend_->update_map(pose, limit, &out.removed_voxels);
   }
-  if (!localizing() && (out.failure.empty() || out.map_restarted))
-    out.map_insert = backend_->update_map(pose, limit, &out.removed_voxels);
   out.map_voxels = backend_->map_voxels();
   out.map_points = backend_->map_points();
   out.timings.map_update_s = seconds_since(t0);

@@ -95,6 +95,10 @@ class ScanPipeline {
   [[nodiscard]] registration::Vec6d last_twist() const;
 
  private:
+  /// Tracks failures in a row; after map_restart_after_s of them, empties the submap (a scan with
+  /// points then starts it again) and returns true.
+  bool restart_map_after_failures(std::int64_t stamp_ns, const FrameResult& result);
+
   Config config_;
   std::string device_message_;
   std::unique_ptr<ScanBackend> backend_;
