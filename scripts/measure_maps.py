@@ -24,6 +24,7 @@ Racetrack: the map is the first lap (85 s), each pass two laps (165 s).
 from __future__ import annotations
 
 import argparse
+import csv
 import json
 import tempfile
 from pathlib import Path
@@ -95,12 +96,13 @@ def run(dataset: Dataset, out: Path, maps: MapOptions) -> dict:
     )  # fmt: skip
 
 
-def frame_ms(out: Path) -> tuple[float, float]:
-    import csv
-
+def frame_stats(out: Path) -> tuple[float, float, float]:
+    """(median, p99 frame time in ms, smallest inlier fraction) of a run's timing.csv."""
     with open(out / "timing.csv") as f:
-        ms = [float(r["total_ms"]) for r in csv.DictReader(f) if r["total_ms"]]
-    return float(np.median(ms)), float(np.percentile(ms, 99))
+        rows = [r for r in csv.DictReader(f) if r["total_ms"]]
+    ms = [float(r["total_ms"]) for r in rows]
+    inliers = [float(r["inlier_fraction"]) for r in rows if r["inlier_fraction"]]
+    return float(np.median(ms)), float(np.percentile(ms, 99)), min(inliers, default=float("nan"))
 
 
 def measure(profile: str, pass_seeds: list[int], out: Path, work: Path) -> dict:
@@ -123,7 +125,7 @@ def measure(profile: str, pass_seeds: list[int], out: Path, work: Path) -> dict:
             common = [k for k in sorted(est) if k in mapping_poses]
             vs_map = np.array([np.linalg.norm(est[k][:3, 3] - mapping_poses[k][:3, 3]) for k in common])
             t_map = (np.array(common) - common[0]) / 1e9
-            med, p99 = frame_ms(o)
+            med, p99, min_inliers = frame_stats(o)
             row[mode] = {
                 "ape_m": s["accuracy"]["ape"]["translation_m"]["rmse"],
                 "err_end_m": float(err[-1]),
@@ -134,13 +136,11 @@ def measure(profile: str, pass_seeds: list[int], out: Path, work: Path) -> dict:
             }
             if mode == "localization":
                 loc = s["localization"]
-                row[mode] |= {"lost": loc["frames_lost"], "localized": loc["frames_localized"]}
-                import csv
-
-                with open(o / "timing.csv") as f:
-                    row[mode]["min_inlier_fraction"] = min(
-                        float(r["inlier_fraction"]) for r in csv.DictReader(f) if r["inlier_fraction"]
-                    )
+                row[mode] |= {
+                    "lost": loc["frames_lost"],
+                    "localized": loc["frames_localized"],
+                    "min_inlier_fraction": min_inliers,
+                }
             curves.setdefault(seed, {})[mode] = {"gt": (t, err), "map": (t_map, vs_map)}
         result["passes"][seed] = row
     plot_curves(profile, curves, out / f"error_over_time_{profile}.png")
