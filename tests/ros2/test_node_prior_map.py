@@ -19,6 +19,8 @@ from loopback import START_TIMEOUT_S, play, wait_for  # noqa: E402
 #: the scan odometry against the mapping run's pose at the same stamp (the map's frame)
 MAX_ERROR_M = 0.05
 MIN_INLIER_FRACTION = 0.9
+#: scans the node must register (the rest only dropped as busy on a loaded machine)
+MIN_PROCESSED_FRACTION = 0.9
 
 
 def test_node_localizes_in_a_prior_map(urban, recorder, start_node, tmp_path):
@@ -39,7 +41,13 @@ def test_node_localizes_in_a_prior_map(urban, recorder, start_node, tmp_path):
 
     diags = recorder.diagnostics()
     assert [d["lost"] for d in diags] == ["False"] * n, [d["message"] for d in diags]
-    assert min(float(d["inlier_fraction"]) for d in diags) > MIN_INLIER_FRACTION
+    # a scan may arrive while the loaded CI machine is still busy with the previous one (dropped
+    # unregistered, as in the paper); every scan the node registered matched the map
+    processed = [d for d in diags if d["processed"] == "True"]
+    dropped = [d["message"] for d in diags if d["processed"] != "True"]
+    assert all("still busy" in m for m in dropped), dropped
+    assert len(processed) >= MIN_PROCESSED_FRACTION * n, dropped
+    assert min(float(d["inlier_fraction"]) for d in processed) > MIN_INLIER_FRACTION
     mapping = _core.io.read_trajectory(tmp_path / "mapping" / SCANS_BODY_TUM)
     expected = {mapping[i][0]: mapping[i][1].translation for i in range(len(mapping))}
     errors = []
@@ -48,5 +56,5 @@ def test_node_localizes_in_a_prior_map(urban, recorder, start_node, tmp_path):
         if stamp in expected:
             p = m.pose.pose.position
             errors.append(np.linalg.norm(np.array([p.x, p.y, p.z]) - expected[stamp]))
-    assert len(errors) >= n - 1  # the first scan's end is estimated live
+    assert len(errors) >= len(processed) - 1  # the first scan's end is estimated live
     assert max(errors) < MAX_ERROR_M, max(errors)
