@@ -85,6 +85,26 @@ INSTANTIATE_TEST_SUITE_P(Perturbations, GicpRecovers,
                          ::testing::Values(std::make_tuple(0.0, 0.0), std::make_tuple(0.5, 0.0),
                                            std::make_tuple(0.0, 5.0), std::make_tuple(0.5, 5.0)));
 
+TEST(Gicp, CorrespondenceReuseKeepsTheResultAndStaleMatchesWouldNot) {
+  Problem pb(make_pose(1.5, -0.7, 0.4, 20.0, 2.0));
+  Vec6d d;
+  d << 0.3, -0.3, 0.3, 0.02, -0.02, 0.08;
+  const SE3 guess = pb.truth * SE3::exp(d);
+  const auto run = [&](double reuse_m) {
+    RegistrationConfig cfg;
+    cfg.correspondence_reuse_m = reuse_m;
+    return register_scan(pb.source, pb.target.view(), guess, Thresholds::from_sigma(1.0), cfg, kNoBudget, pb.ex);
+  };
+  const auto fresh = run(0.0), reused = run(RegistrationConfig{}.correspondence_reuse_m), stale = run(1e3);
+  ASSERT_TRUE(fresh.converged && reused.converged);
+  EXPECT_LT(trans_err(reused.pose, pb.truth), 0.02);
+  EXPECT_LT(rot_err_deg(reused.pose, pb.truth), 0.1);
+  EXPECT_LT(trans_err(reused.pose, fresh.pose), 0.005);
+  // never searching again after the first iteration (matches from 0.5 m off) ends elsewhere:
+  // the reuse distance is what keeps the matches current
+  EXPECT_GT(trans_err(stale.pose, pb.truth), 2.0 * std::max(trans_err(reused.pose, pb.truth), 0.005));
+}
+
 TEST(Gicp, PointToPointFallbackWithoutCovariance) {
   // A source point without a covariance is weighted by Omega = lambda I (Sigma_s = 0): the
   // paper's lambda = 1 here.

@@ -5,9 +5,11 @@
 
 #include <cmath>
 #include <limits>
+#include <random>
 #include <vector>
 
 #include "farlio/exec/cpu_executor.hpp"
+#include "farlio/map/neighbor_search.hpp"
 #include "farlio/map/voxel_map.hpp"
 #include "farlio/map/voxel_update.hpp"
 #include "farlio/pipeline/range_crop.hpp"
@@ -94,4 +96,52 @@ TEST(SharedBodies, FactorSumsReduceToTheSameSystemAsPerPointSums) {
   EXPECT_LT((sys.H - ref.H).norm(), 1e-9 * ref.H.norm());
   EXPECT_LT((sys.b - ref.b).norm(), 1e-9 * (ref.b.norm() + 1.0));
   EXPECT_NEAR(sys.error, ref.error, 1e-9 * (ref.error + 1.0));
+}
+
+TEST(SharedBodies, PerVoxelCovariancesEqualThePerPointBodyOfCuda) {
+  // the CPU computes a voxel's covariances with its 27 neighbours looked up once, CUDA one
+  // point a thread with its own lookups: bit-identical covariances and shapes
+  exec::CpuExecutor ex(2);
+  VoxelMapConfig cfg;
+  cfg.max_points_per_voxel = 20;
+  map::VoxelMap frame(cfg, ex);
+  frame.insert(test::sample_scene(30000, 5), Eigen::Vector3f::Zero(), map::PointLimit::constant(20));
+  const map::MapSnapshot cpu = frame.snapshot();
+  const map::MapView v = frame.view();
+  std::size_t compared = 0, with_covariance = 0;
+  for (std::size_t vox = 0; vox < cpu.voxel_keys.size(); ++vox) {
+    for (std::int32_t j = 0; j < cpu.voxel_counts[vox]; ++j) {
+      map::update_point_covariance(v, static_cast<std::int32_t>(vox), j, cfg.covariance_neighbors,
+                                   static_cast<float>(cfg.covariance_epsilon),
+                                   static_cast<float>(cfg.line_eigenvalue_ratio));
+      const std::int64_t i = v.point_index(static_cast<std::int32_t>(vox), j);
+      const auto k = static_cast<std::size_t>(i);
+      ASSERT_EQ(v.points[i].w(), cpu.points[k].w()) << "voxel " << vox << " point " << j;
+      if (map::has_covariance(cpu.points[k])) {
+        EXPECT_EQ(v.covs[i].matrix(), cpu.covs[k].matrix());
+        ++with_covariance;
+      }
+      ++compared;
+    }
+  }
+  EXPECT_GT(compared, 2000u);
+  EXPECT_GT(with_covariance, compared / 2);
+}
+
+TEST(SharedBodies, BlockDistancesEqualTheBoxDistanceOfEachVoxel) {
+  // the neighbour searches prune voxels with BlockDistances: the same floats as
+  // voxel_box_distance2, so the voxels visited (and the matches) do not change
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(-300.0f, 300.0f);
+  for (float voxel : {4.0f, 1.0f, 0.37f}) {
+    for (int q = 0; q < 2000; ++q) {
+      const Eigen::Vector3f p(u(rng), u(rng), 0.1f * u(rng));
+      const map::VoxelCoord c0 = map::voxel_of(p, 1.0f / voxel);
+      const map::BlockDistances box(p, c0, voxel);
+      for (int n = 0; n < map::kNeighborVoxels; ++n) {
+        ASSERT_EQ(box.distance2(n), map::voxel_box_distance2(p, map::neighbor_voxel(c0, n), voxel)) << n;
+      }
+      EXPECT_EQ(box.distance2(0), 0.0f);
+    }
+  }
 }

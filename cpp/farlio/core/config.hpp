@@ -121,6 +121,9 @@ inline constexpr double kMaxThreads = 1024.0;
   FIELD(int, max_iterations, 500, range::between(1, kMaxCount), "Gauss-Newton iterations at most")                \
   FIELD(double, convergence_norm, 5e-3, range::positive_up_to(kMaxSiValue),                                       \
         "stop when |dx| (6-vector, m and rad) falls below this")                                                  \
+  FIELD(double, correspondence_reuse_m, 0.02, range::non_negative_up_to(kMaxSiValue),                             \
+        "a source point keeps its map match over Gauss-Newton iterations until it has moved this far from where " \
+        "the match was searched (0: a search every iteration, as the paper; the CUDA backend always searches)")   \
   FIELD(double, time_budget_factor, 2.0, range::positive_up_to_or_inf(kMaxRatio),                                 \
         "time budget in LiDAR periods (paper: 2); a frame over it is dropped (inf: no budget)")                   \
   FIELD(double, damping, 1e-9, range::non_negative_up_to(kMaxRatio), "lambda added to the diagonal of H")         \

@@ -72,14 +72,16 @@ class CudaScanBackend final : public pipeline::ScanBackend {
     const std::size_t n = scan.size();
     raw_.upload(scan.points.data(), n, executor_.stream(), kScanParameter);
     if (undistort) times_.upload(scan.time_s.data(), n, executor_.stream(), kScanParameter);
-    frame_size_ = n == 0 ? 0 : downsample(n, motion, undistort);
+    frame_size_ =
+        n == 0 ? 0
+               : downsample(n, deskew::DeskewTable::sample(motion, static_cast<float>(scan.duration_s())), undistort);
     timer_.stop(StageTimer::kPreprocess);
     return frame_size_;
   }
 
   /// Crop, undistortion and the keys of the downsampling cells (one thread a point), then the
   /// first point of each cell in (cell key, input order), as CpuScanBackend::preprocess.
-  std::size_t downsample(std::size_t n, const deskew::ScanMotion& motion, bool undistort) {
+  std::size_t downsample(std::size_t n, const deskew::DeskewTable& motion, bool undistort) {
     const pipeline::PreprocessParams pp{pipeline::RangeCrop::from(config_.preprocess), motion, undistort,
                                         1.0f / map_.spacing_m()};
     const Eigen::Vector3f* raw = raw_.data();

@@ -13,6 +13,9 @@ namespace farlio::map {
 
 /// Largest k supported by knn_search (fixed-size per-thread storage).
 inline constexpr int kMaxNeighbors = 32;
+/// Points of a voxel whose distances the searches compute together (one loop the compiler
+/// vectorises, then the comparisons).
+inline constexpr int kDistanceBlock = 16;
 
 /// Squared distance from p to the box of voxel c (0 inside).
 FARLIO_HD inline float voxel_box_distance2(const Eigen::Vector3f& p, const VoxelCoord& c, float voxel_size) {
@@ -26,19 +29,100 @@ FARLIO_HD inline float voxel_box_distance2(const Eigen::Vector3f& p, const Voxel
   return d2;
 }
 
+/// Squared distances from p to the points [first, first + min(remaining, kDistanceBlock)) of the
+/// pool, into d2; returns how many.
+FARLIO_HD inline std::int32_t block_distances2(const ConstMapView& m, std::int64_t first, std::int32_t remaining,
+                                               const Eigen::Vector3f& p, float* d2) {
+  const std::int32_t len = remaining < kDistanceBlock ? remaining : kDistanceBlock;
+  for (std::int32_t j = 0; j < len; ++j) {
+    const Eigen::Vector4f& q = m.points[first + j];
+    const float dx = q.x() - p.x(), dy = q.y() - p.y(), dz = q.z() - p.z();
+    d2[j] = dx * dx + dy * dy + dz * dz;
+  }
+  return len;
+}
+
+/// Voxels visited around a query: the 27 of the 3x3x3 block, its centre first.
+inline constexpr int kNeighborVoxels = 27;
+
+/// The block position of the n-th voxel around a centre (n = 0 is the centre, the rest in a
+/// fixed order): axis a is offset by digit a of the code in base 3, minus 1.
+FARLIO_HD inline int neighbor_code(int n) {
+  constexpr int kCentreCode = 13;
+  return n == 0 ? kCentreCode : (n <= kCentreCode ? n - 1 : n);
+}
+
+/// The n-th voxel of the block around c0.
+FARLIO_HD inline VoxelCoord neighbor_voxel(const VoxelCoord& c0, int n) {
+  const int code = neighbor_code(n);
+  return {c0.x() + code % 3 - 1, c0.y() + (code / 3) % 3 - 1, c0.z() + code / 9 - 1};
+}
+
+/// voxel_box_distance2 from p to each voxel of the block around c0, from 9 distances along the
+/// axes computed once per query instead of 3 per voxel (the same floats in the same sums).
+struct BlockDistances {
+  float along[3][3];  ///< [axis][offset + 1]: distance from p to that slab along the axis
+
+  FARLIO_HD BlockDistances(const Eigen::Vector3f& p, const VoxelCoord& c0, float voxel_size) {
+    for (int a = 0; a < 3; ++a) {
+      for (int o = 0; o < 3; ++o) {
+        const float lo = static_cast<float>(c0[a] + o - 1) * voxel_size;
+        const float hi = lo + voxel_size;
+        along[a][o] = p[a] < lo ? lo - p[a] : (p[a] > hi ? p[a] - hi : 0.0f);
+      }
+    }
+  }
+  /// Squared distance from p to the box of the n-th voxel of the block.
+  [[nodiscard]] FARLIO_HD float distance2(int n) const {
+    const int code = neighbor_code(n);
+    const float dx = along[0][code % 3], dy = along[1][(code / 3) % 3], dz = along[2][code / 9];
+    float d2 = 0.0f;
+    d2 += dx * dx;
+    d2 += dy * dy;
+    d2 += dz * dz;
+    return d2;
+  }
+};
+
 /// Calls visit(voxel_index) for each of the 27 voxels around p (centre first) that exists and
-/// whose box is closer than bound2() (re-read before each voxel, so it may shrink).
+/// whose box is closer than bound2() (re-read before each voxel, so it may shrink). Looks a
+/// voxel up only when its box passes the bound.
 template <typename Visit, typename Bound>
 FARLIO_HD void for_each_nearby_voxel(const ConstMapView& m, const Eigen::Vector3f& p, const Bound& bound2,
                                      const Visit& visit) {
   const VoxelCoord c0 = voxel_of(p, m.inv_voxel_size);
-  for (int n = 0; n < 27; ++n) {
-    // n = 0 is the centre voxel; the rest in a fixed order.
-    const int code = n == 0 ? 13 : (n <= 13 ? n - 1 : n);
-    const VoxelCoord c(c0.x() + code % 3 - 1, c0.y() + (code / 3) % 3 - 1, c0.z() + code / 9 - 1);
-    if (n > 0 && voxel_box_distance2(p, c, m.voxel_size) >= bound2()) continue;
-    const std::int32_t v = table_find(m, c);
+  const BlockDistances box(p, c0, m.voxel_size);
+  for (int n = 0; n < kNeighborVoxels; ++n) {
+    if (n > 0 && box.distance2(n) >= bound2()) continue;
+    const std::int32_t v = table_find(m, neighbor_voxel(c0, n));
     if (v >= 0) visit(v);
+  }
+}
+
+/// The 27 voxels around a voxel, looked up once for all the queries that lie in it (the
+/// covariances of a voxel's points): the same voxels, in the same order, as
+/// for_each_nearby_voxel visits for any point of the centre voxel.
+struct VoxelNeighborhood {
+  VoxelCoord centre;
+  std::int32_t voxels[kNeighborVoxels];  ///< pool index of each, -1 when absent
+};
+
+FARLIO_HD inline VoxelNeighborhood voxel_neighborhood(const ConstMapView& m, const VoxelCoord& centre) {
+  VoxelNeighborhood nb;
+  nb.centre = centre;
+  for (int n = 0; n < kNeighborVoxels; ++n) nb.voxels[n] = table_find(m, neighbor_voxel(centre, n));
+  return nb;
+}
+
+/// for_each_nearby_voxel over a neighbourhood looked up before (p must lie in its centre voxel).
+template <typename Visit, typename Bound>
+FARLIO_HD void for_each_nearby_voxel(const ConstMapView& m, const VoxelNeighborhood& nb, const Eigen::Vector3f& p,
+                                     const Bound& bound2, const Visit& visit) {
+  const BlockDistances box(p, nb.centre, m.voxel_size);
+  for (int n = 0; n < kNeighborVoxels; ++n) {
+    if (nb.voxels[n] < 0) continue;
+    if (n > 0 && box.distance2(n) >= bound2()) continue;
+    visit(nb.voxels[n]);
   }
 }
 
@@ -51,12 +135,15 @@ FARLIO_HD inline std::int64_t nearest_neighbor(const ConstMapView& m, const Eige
       m, p, [&] { return best; },
       [&](std::int32_t v) {
         const std::int32_t n = m.voxel_counts[v];
-        for (std::int32_t j = 0; j < n; ++j) {
-          const std::int64_t idx = m.point_index(v, j);
-          const float d2 = (m.points[idx].head<3>() - p).squaredNorm();
-          if (d2 < best) {
-            best = d2;
-            best_index = idx;
+        const std::int64_t first = m.point_index(v, 0);
+        for (std::int32_t j0 = 0; j0 < n; j0 += kDistanceBlock) {
+          float d2[kDistanceBlock];
+          const std::int32_t len = block_distances2(m, first + j0, n - j0, p, d2);
+          for (std::int32_t j = 0; j < len; ++j) {
+            if (d2[j] < best) {
+              best = d2[j];
+              best_index = first + j0 + j;
+            }
           }
         }
       });
@@ -65,29 +152,52 @@ FARLIO_HD inline std::int64_t nearest_neighbor(const ConstMapView& m, const Eige
 }
 
 /// The k nearest points to p (k <= kMaxNeighbors) within sqrt(max_distance2), sorted by
-/// distance. Returns how many were found (< k when the neighbourhood holds fewer).
-FARLIO_HD inline int knn_search(const ConstMapView& m, const Eigen::Vector3f& p, int k, float max_distance2,
-                                std::int64_t* indices, float* distances2) {
+/// distance, over the voxels walk(bound2, visit) visits. Returns how many were found.
+template <typename Walk>
+FARLIO_HD int knn_over(const ConstMapView& m, const Walk& walk, const Eigen::Vector3f& p, int k, float max_distance2,
+                       std::int64_t* indices, float* distances2) {
   int found = 0;
   auto bound = [&] { return found < k ? max_distance2 : distances2[k - 1]; };
-  for_each_nearby_voxel(m, p, bound, [&](std::int32_t v) {
+  walk(bound, [&](std::int32_t v) {
     const std::int32_t n = m.voxel_counts[v];
-    for (std::int32_t j = 0; j < n; ++j) {
-      const std::int64_t idx = m.point_index(v, j);
-      const float d2 = (m.points[idx].head<3>() - p).squaredNorm();
-      if (d2 >= bound()) continue;
-      // insertion into the sorted list
-      int pos = found < k ? found++ : k - 1;
-      while (pos > 0 && distances2[pos - 1] > d2) {
-        distances2[pos] = distances2[pos - 1];
-        indices[pos] = indices[pos - 1];
-        --pos;
+    const std::int64_t first = m.point_index(v, 0);
+    // distances of a block of points first, then the few that pass the bound are inserted
+    for (std::int32_t j0 = 0; j0 < n; j0 += kDistanceBlock) {
+      float block[kDistanceBlock];
+      const std::int32_t len = block_distances2(m, first + j0, n - j0, p, block);
+      float b = bound();
+      for (std::int32_t j = 0; j < len; ++j) {
+        const float d2 = block[j];
+        if (d2 >= b) continue;
+        // insertion into the sorted list
+        int pos = found < k ? found++ : k - 1;
+        while (pos > 0 && distances2[pos - 1] > d2) {
+          distances2[pos] = distances2[pos - 1];
+          indices[pos] = indices[pos - 1];
+          --pos;
+        }
+        distances2[pos] = d2;
+        indices[pos] = first + j0 + j;
+        b = bound();
       }
-      distances2[pos] = d2;
-      indices[pos] = idx;
     }
   });
   return found;
+}
+
+/// The k nearest points to p (k <= kMaxNeighbors) within sqrt(max_distance2), sorted by
+/// distance. Returns how many were found (< k when the neighbourhood holds fewer).
+FARLIO_HD inline int knn_search(const ConstMapView& m, const Eigen::Vector3f& p, int k, float max_distance2,
+                                std::int64_t* indices, float* distances2) {
+  const auto walk = [&](const auto& bound, const auto& visit) { for_each_nearby_voxel(m, p, bound, visit); };
+  return knn_over(m, walk, p, k, max_distance2, indices, distances2);
+}
+
+/// knn_search for a point of the centre voxel of `nb` (the same result, without the lookups).
+FARLIO_HD inline int knn_search(const ConstMapView& m, const VoxelNeighborhood& nb, const Eigen::Vector3f& p, int k,
+                                float max_distance2, std::int64_t* indices, float* distances2) {
+  const auto walk = [&](const auto& bound, const auto& visit) { for_each_nearby_voxel(m, nb, p, bound, visit); };
+  return knn_over(m, walk, p, k, max_distance2, indices, distances2);
 }
 
 }  // namespace farlio::map

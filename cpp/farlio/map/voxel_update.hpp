@@ -93,16 +93,17 @@ FARLIO_HD inline PointRange covariance_points(std::int32_t count, std::int32_t f
 /// No distance limit for the covariance neighbours (the 27 voxels bound them).
 inline constexpr float kUnboundedDistance2 = std::numeric_limits<float>::max();
 
-/// Covariance (eq. 1) of point j of `voxel` from its k nearest neighbours, and its shape in w
-/// (map::PointShape: no covariance with fewer than k neighbours, else surface or line by
-/// `line_ratio`). Reads the points of the 27 voxels around it.
-FARLIO_HD inline void update_point_covariance(const MapView& m, std::int32_t voxel, std::int32_t j, int k,
-                                              float epsilon, float line_ratio) {
+/// Covariance (eq. 1) of point j of `voxel` from its k nearest neighbours found by
+/// knn(p, idx, d2), and its shape in w (map::PointShape: no covariance with fewer than k
+/// neighbours, else surface or line by `line_ratio`).
+template <typename Knn>
+FARLIO_HD void point_covariance(const MapView& m, std::int32_t voxel, std::int32_t j, int k, float epsilon,
+                                float line_ratio, const Knn& knn) {
   std::int64_t idx[kMaxNeighbors];
   float d2[kMaxNeighbors];
   const std::int64_t pi = m.point_index(voxel, j);
   const Eigen::Vector3f p = m.points[pi].head<3>();
-  const int found = knn_search(m, p, k, kUnboundedDistance2, idx, d2);
+  const int found = knn(p, idx, d2);
   if (found < k) {
     m.points[pi].w() = shape_code(PointShape::NoCovariance);
     return;
@@ -114,10 +115,26 @@ FARLIO_HD inline void update_point_covariance(const MapView& m, std::int32_t vox
   m.points[pi].w() = shape_code(classify_shape(cov, line_ratio));
 }
 
-/// Covariances of the points `points` of `voxel` (one CPU task a voxel).
+/// The covariance of point j of `voxel` (one GPU thread a point): reads the points of the 27
+/// voxels around it.
+FARLIO_HD inline void update_point_covariance(const MapView& m, std::int32_t voxel, std::int32_t j, int k,
+                                              float epsilon, float line_ratio) {
+  point_covariance(m, voxel, j, k, epsilon, line_ratio, [&](const Eigen::Vector3f& p, std::int64_t* idx, float* d2) {
+    return knn_search(m, p, k, kUnboundedDistance2, idx, d2);
+  });
+}
+
+/// Covariances of the points `points` of `voxel` (one CPU task a voxel): the 27 voxels around
+/// it are looked up once for all of them (the same result as update_point_covariance).
 FARLIO_HD inline void update_voxel_covariances(const MapView& m, std::int32_t voxel, const PointRange& points, int k,
                                                float epsilon, float line_ratio) {
-  for (std::int32_t j = points.begin; j < points.end; ++j) update_point_covariance(m, voxel, j, k, epsilon, line_ratio);
+  if (points.size() == 0) return;
+  const VoxelNeighborhood nb = voxel_neighborhood(m, unpack_key(m.voxel_keys[voxel]));
+  for (std::int32_t j = points.begin; j < points.end; ++j) {
+    point_covariance(m, voxel, j, k, epsilon, line_ratio, [&](const Eigen::Vector3f& p, std::int64_t* idx, float* d2) {
+      return knn_search(m, nb, p, k, kUnboundedDistance2, idx, d2);
+    });
+  }
 }
 
 /// Squared distance (double) from `origin` to the centre of the voxel with this key.

@@ -1,6 +1,5 @@
 #include "farlio/pipeline/cpu_scan_backend.hpp"
 
-#include "farlio/pipeline/preprocess.hpp"
 #include "farlio/pipeline/preprocess_point.hpp"
 
 namespace farlio::pipeline {
@@ -18,17 +17,19 @@ void CpuScanBackend::reset(const Config& config) {
 }
 
 std::size_t CpuScanBackend::preprocess(const Scan& scan, const deskew::ScanMotion& motion, bool undistort) {
-  const PreprocessParams pp{RangeCrop::from(config_.preprocess), motion, undistort, 1.0f / map_.spacing_m()};
+  const PreprocessParams pp{RangeCrop::from(config_.preprocess),
+                            deskew::DeskewTable::sample(motion, static_cast<float>(scan.duration_s())), undistort,
+                            1.0f / map_.spacing_m()};
   const std::size_t n = scan.size();
-  std::vector<Eigen::Vector3f> points(n);
-  std::vector<std::pair<std::uint64_t, std::int32_t>> keyed(n);
+  points_.resize(n);  // buffers kept across scans: no allocation once grown
+  keys_.resize(n);
   executor_.for_each(n, [&](std::size_t i) {
     const float tau = undistort ? scan.time_s[i] : 0.0f;
-    keyed[i] = {preprocess_point(scan.points[i], tau, pp, &points[i]), static_cast<std::int32_t>(i)};
+    keys_[i] = preprocess_point(scan.points[i], tau, pp, &points_[i]);
   });
-  const std::vector<std::int32_t> kept = first_of_each_cell(keyed, executor_);
+  const std::vector<std::int32_t>& kept = downsampler_.first_of_each_cell(keys_.data(), n, executor_);
   frame_.resize(kept.size());
-  for (std::size_t k = 0; k < kept.size(); ++k) frame_[k] = points[static_cast<std::size_t>(kept[k])];
+  for (std::size_t k = 0; k < kept.size(); ++k) frame_[k] = points_[static_cast<std::size_t>(kept[k])];
   return frame_.size();
 }
 

@@ -1,10 +1,12 @@
 #pragma once
 // The scan pipeline's stages on the CPU executor (TBB arena of config.num_threads threads)
 // over host voxel maps.
+#include <cstdint>
 #include <vector>
 
 #include "farlio/exec/cpu_executor.hpp"
 #include "farlio/map/voxel_map.hpp"
+#include "farlio/pipeline/cell_downsampler.hpp"
 #include "farlio/pipeline/scan_backend.hpp"
 
 namespace farlio::pipeline {
@@ -32,7 +34,10 @@ class CpuScanBackend final : public ScanBackend {
   exec::CpuExecutor executor_;
   map::VoxelMap map_;
   map::VoxelMap frame_map_;
-  std::vector<Eigen::Vector3f> frame_;  // the kept points (sensor frame, scan end)
+  CellDownsampler downsampler_;
+  std::vector<Eigen::Vector3f> points_;  // preprocessed points of the scan (valid where keys_ is)
+  std::vector<std::uint64_t> keys_;      // their downsampling cells
+  std::vector<Eigen::Vector3f> frame_;   // the kept points (sensor frame, scan end)
   registration::SourceCloud source_;
 };
 

@@ -73,7 +73,8 @@ std::size_t MapExport::add(const Scan& scan, const deskew::ScanMotion& motion, b
   if (!spill_dir_.empty()) reload_near(sensor);
   const bool deskew = undistort && scan.has_time();
   // the cell size is not used here: only the crop and the undistortion of preprocess_point
-  const PreprocessParams pp{RangeCrop::from(preprocess_), motion, deskew, 1.0f};
+  const PreprocessParams pp{RangeCrop::from(preprocess_),
+                            deskew::DeskewTable::sample(motion, static_cast<float>(scan.duration_s())), deskew, 1.0f};
   const Eigen::Matrix3d R = pose.rotation();
   const auto inv_cell = static_cast<float>(1.0 / resolution_m_);
   const bool has_intensity = scan.intensity.size() == scan.size();

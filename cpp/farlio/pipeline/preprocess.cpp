@@ -1,11 +1,10 @@
 #include "farlio/pipeline/preprocess.hpp"
 
-#include <tbb/parallel_sort.h>
-
 #include <algorithm>
 #include <cmath>
 
 #include "farlio/map/voxel_update.hpp"
+#include "farlio/pipeline/cell_downsampler.hpp"
 #include "farlio/pipeline/range_crop.hpp"
 
 namespace farlio::pipeline {
@@ -23,25 +22,15 @@ std::vector<std::int32_t> crop_by_range(const std::vector<Eigen::Vector3f>& poin
 std::vector<std::int32_t> voxel_downsample(const std::vector<Eigen::Vector3f>& points,
                                            const std::vector<std::int32_t>& indices, float cell_m,
                                            exec::CpuExecutor& executor) {
-  // (cell key, position in `indices`) sorted: the first of each cell is kept.
-  std::vector<std::pair<std::uint64_t, std::int32_t>> keyed(indices.size());
+  // the cell key of each point in the order of `indices`: the first of each cell is kept
+  std::vector<std::uint64_t> keys(indices.size());
   const float inv = 1.0f / cell_m;
   executor.for_each(indices.size(), [&](std::size_t i) {
-    keyed[i] = {map::point_key(points[static_cast<std::size_t>(indices[i])], inv), static_cast<std::int32_t>(i)};
+    keys[i] = map::point_key(points[static_cast<std::size_t>(indices[i])], inv);
   });
-  std::vector<std::int32_t> kept = first_of_each_cell(keyed, executor);
+  CellDownsampler downsampler;
+  std::vector<std::int32_t> kept = downsampler.first_of_each_cell(keys.data(), keys.size(), executor);
   for (auto& k : kept) k = indices[static_cast<std::size_t>(k)];
-  return kept;
-}
-
-std::vector<std::int32_t> first_of_each_cell(std::vector<std::pair<std::uint64_t, std::int32_t>>& keyed,
-                                             exec::CpuExecutor& executor) {
-  executor.run([&] { tbb::parallel_sort(keyed.begin(), keyed.end()); });
-  std::vector<std::int32_t> kept;
-  for (std::size_t i = 0; i < keyed.size(); ++i) {
-    if (keyed[i].first == map::kEmptyKey) break;
-    if (i == 0 || keyed[i].first != keyed[i - 1].first) kept.push_back(keyed[i].second);
-  }
   return kept;
 }
 

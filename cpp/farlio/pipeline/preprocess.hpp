@@ -2,7 +2,6 @@
 // Preprocessing of a scan: range crop and voxel-grid downsampling to the map spacing.
 #include <Eigen/Core>
 #include <cstdint>
-#include <utility>
 #include <vector>
 
 #include "farlio/core/config.hpp"
@@ -18,11 +17,6 @@ std::vector<std::int32_t> crop_by_range(const std::vector<Eigen::Vector3f>& poin
 std::vector<std::int32_t> voxel_downsample(const std::vector<Eigen::Vector3f>& points,
                                            const std::vector<std::int32_t>& indices, float cell_m,
                                            exec::CpuExecutor& executor);
-
-/// Sorts (cell key, index) pairs and returns the index of the first pair of each key, in key
-/// order; pairs with kEmptyKey are dropped. The downsampling of both preprocessing paths.
-std::vector<std::int32_t> first_of_each_cell(std::vector<std::pair<std::uint64_t, std::int32_t>>& keyed,
-                                             exec::CpuExecutor& executor);
 
 /// The voxel size for a scene whose first scan is `points` (sensor frame): see
 /// VoxelMapConfig::auto_voxel_size. Returns config.voxel_size_m when auto is off or the scan

@@ -14,7 +14,7 @@ namespace farlio::pipeline {
 
 struct PreprocessParams {
   RangeCrop crop;
-  deskew::ScanMotion motion;
+  deskew::DeskewTable motion;  ///< the scan's motion (DeskewTable::sample), read when undistort
   bool undistort = false;
   float inv_cell_m = 1.0f;  ///< 1 / downsampling cell (the map spacing)
 };

@@ -36,17 +36,32 @@ struct AddFactorSums {
   FARLIO_HD FactorSums operator()(FactorSums a, const FactorSums& b) const { return a += b; }
 };
 
-/// The factor of source point i as sums (zero when it has no correspondence).
-FARLIO_HD inline FactorSums factor_sums(const map::ConstMapView& target, const Eigen::Vector4f& point,
-                                        const map::Cov3& cov, const FactorParams& fp) {
+/// A factor's terms as sums (zero when `found` is false: no correspondence).
+FARLIO_HD inline FactorSums factor_sums_of(bool found, const FactorTerms& f) {
   FactorSums a = FactorSums::zero();
-  FactorTerms f;
-  if (!gicp_factor(target, point, cov, fp, f)) return a;
+  if (!found) return a;
   for (int k = 0; k < kHEntries; ++k) a.v[k] = f.H[k];
   for (int k = 0; k < kBEntries; ++k) a.v[kHEntries + k] = f.b[k];
   a.v[FactorSums::kCost] = f.cost;
   a.v[FactorSums::kInliers] = 1.0;
   return a;
+}
+
+/// The factor of source point i as sums (zero when it has no correspondence).
+FARLIO_HD inline FactorSums factor_sums(const map::ConstMapView& target, const Eigen::Vector4f& point,
+                                        const map::Cov3& cov, const FactorParams& fp) {
+  FactorTerms f;
+  const bool found = gicp_factor(target, point, cov, fp, f);
+  return factor_sums_of(found, f);
+}
+
+/// factor_sums with the correspondence `c` kept across iterations (gicp_factor_reusing).
+FARLIO_HD inline FactorSums factor_sums_reusing(const map::ConstMapView& target, const Eigen::Vector4f& point,
+                                                const map::Cov3& cov, const FactorParams& fp, float reuse_distance2,
+                                                Correspondence& c) {
+  FactorTerms f;
+  const bool found = gicp_factor_reusing(target, point, cov, fp, reuse_distance2, c, f);
+  return factor_sums_of(found, f);
 }
 
 /// The symmetric linear system of the sums (host).

@@ -53,8 +53,22 @@ LinearSystem build_linear_system(const SourceCloud& source, const map::ConstMapV
 RegistrationResult register_scan(const SourceCloud& source, const map::ConstMapView& target, const SE3& initial_guess,
                                  const Thresholds& th, const RegistrationConfig& config, double time_budget_s,
                                  exec::CpuExecutor& executor) {
-  return gauss_newton([&](const SE3& T) { return build_linear_system(source, target, T, th, config, executor); },
-                      initial_guess, config, time_budget_s);
+  if (config.correspondence_reuse_m <= 0.0) {
+    return gauss_newton([&](const SE3& T) { return build_linear_system(source, target, T, th, config, executor); },
+                        initial_guess, config, time_budget_s);
+  }
+  std::vector<Correspondence> matches(source.size());
+  const auto reuse2 = static_cast<float>(config.correspondence_reuse_m * config.correspondence_reuse_m);
+  const auto build = [&](const SE3& T) {
+    const FactorParams fp = factor_params(T, th, config);
+    return to_linear_system(executor.reduce(
+        source.size(), FactorSums::zero(),
+        [&](std::size_t i) {
+          return factor_sums_reusing(target, source.points[i], source.covs[i], fp, reuse2, matches[i]);
+        },
+        AddFactorSums{}));
+  };
+  return gauss_newton(build, initial_guess, config, time_budget_s);
 }
 
 std::string failure_reason(const RegistrationResult& result, std::size_t source_points,

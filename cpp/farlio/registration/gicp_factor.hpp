@@ -11,6 +11,7 @@
 // perturbation T exp(delta), delta = [rho; phi], is J = [R, -R [s]x].
 #include <Eigen/Core>
 #include <Eigen/LU>
+#include <cstdint>
 
 #include "farlio/exec/hd.hpp"
 #include "farlio/exec/hd_math.hpp"
@@ -38,16 +39,18 @@ struct FactorParams {
   float point_to_point_precision = 1.0f;  ///< lambda, in the Frobenius-normalised units of Omega
 };
 
-/// Computes the factor of source point `s` (w = 1 if `cov_s` is valid). Returns false (and
-/// leaves `out` untouched) when there is no correspondence within the distance.
-FARLIO_HD inline bool gicp_factor(const map::ConstMapView& m, const Eigen::Vector4f& s, const map::Cov3& cov_s,
-                                  const FactorParams& fp, FactorTerms& out) {
-  const Eigen::Vector3f sp = s.head<3>();
-  const Eigen::Vector3f p = fp.R * sp + fp.t;
-  const std::int64_t nn = map::nearest_neighbor(m, p, fp.max_correspondence_distance2);
+/// The factor of source point `s` (w = 1 if `cov_s` is valid) at its transformed position
+/// p = R s + t, matched to map point `nn` (-1: none). Returns false (and leaves `out` untouched)
+/// when there is no correspondence within the distance.
+FARLIO_HD inline bool gicp_factor_at(const map::ConstMapView& m, const Eigen::Vector4f& s, const map::Cov3& cov_s,
+                                     const Eigen::Vector3f& p, std::int64_t nn, const FactorParams& fp,
+                                     FactorTerms& out) {
   if (nn < 0) return false;
+  const Eigen::Vector3f sp = s.head<3>();
   const Eigen::Vector4f& q = m.points[nn];
   const Eigen::Vector3f r = p - q.head<3>();
+  const float r2 = r.squaredNorm();
+  if (!(r2 <= fp.max_correspondence_distance2)) return false;  // a reused match that moved out of the gate
   Eigen::Matrix3f omega = Eigen::Matrix3f::Identity();
   const bool both_covariances = map::has_covariance(s) && map::has_covariance(q);
   if (fp.sparsity_aware && fp.skip_line_pairs && map::is_line_like(s) && map::is_line_like(q)) return false;
@@ -57,7 +60,6 @@ FARLIO_HD inline bool gicp_factor(const map::ConstMapView& m, const Eigen::Vecto
     const Eigen::Matrix3f inv = c.inverse();
     if (exec::all_finite(inv)) omega = inv;
   }
-  const float r2 = r.squaredNorm();
   const float w = fp.kernel.weight(r2);
   Eigen::Matrix<float, 3, 6> J;
   J.leftCols<3>() = fp.R;
@@ -75,6 +77,38 @@ FARLIO_HD inline bool gicp_factor(const map::ConstMapView& m, const Eigen::Vecto
   out.cost = fp.kernel.cost(r2);
   out.inlier = 1;
   return true;
+}
+
+/// Computes the factor of source point `s` with its nearest map point searched at the current
+/// pose. Returns false (and leaves `out` untouched) when there is no correspondence within the
+/// distance.
+FARLIO_HD inline bool gicp_factor(const map::ConstMapView& m, const Eigen::Vector4f& s, const map::Cov3& cov_s,
+                                  const FactorParams& fp, FactorTerms& out) {
+  const Eigen::Vector3f p = fp.R * s.head<3>() + fp.t;
+  return gicp_factor_at(m, s, cov_s, p, map::nearest_neighbor(m, p, fp.max_correspondence_distance2), fp, out);
+}
+
+/// One source point's correspondence kept across Gauss-Newton iterations: the map point found
+/// and where the point was when it was searched.
+struct Correspondence {
+  Eigen::Vector3f searched_at;
+  std::int64_t nn = -1;
+  bool valid = false;  ///< false before the first search
+};
+
+/// gicp_factor, but the nearest neighbour is searched again only when the point moved by
+/// `reuse_distance_m` or more since its last search (the iterations after the first move most
+/// points by millimetres, which changes almost no match); `c` is updated.
+FARLIO_HD inline bool gicp_factor_reusing(const map::ConstMapView& m, const Eigen::Vector4f& s, const map::Cov3& cov_s,
+                                          const FactorParams& fp, float reuse_distance2, Correspondence& c,
+                                          FactorTerms& out) {
+  const Eigen::Vector3f p = fp.R * s.head<3>() + fp.t;
+  if (!c.valid || (p - c.searched_at).squaredNorm() >= reuse_distance2) {
+    c.nn = map::nearest_neighbor(m, p, fp.max_correspondence_distance2);
+    c.searched_at = p;
+    c.valid = true;
+  }
+  return gicp_factor_at(m, s, cov_s, p, c.nn, fp, out);
 }
 
 }  // namespace farlio::registration
