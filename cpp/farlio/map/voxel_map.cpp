@@ -1,7 +1,5 @@
 #include "farlio/map/voxel_map.hpp"
 
-#include <tbb/parallel_sort.h>
-
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -75,29 +73,19 @@ InsertStats VoxelMap::insert(const std::vector<Eigen::Vector3f>& points, const E
   stats.candidates = points.size();
   const float inv_voxel = static_cast<float>(1.0 / config_.voxel_size_m);
 
-  // 1. group candidates by voxel, in input order inside a voxel
-  std::vector<std::pair<std::uint64_t, std::int32_t>> keyed(points.size());
-  executor_->for_each(points.size(), [&](std::size_t i) {
-    keyed[i] = {point_key(points[i], inv_voxel), static_cast<std::int32_t>(i)};
-  });
-  executor_->run([&] { tbb::parallel_sort(keyed.begin(), keyed.end()); });
-  while (!keyed.empty() && keyed.back().first == kEmptyKey) {
-    keyed.pop_back();
-    ++stats.out_of_range;
-  }
-  std::vector<std::size_t> group_start;
-  for (std::size_t i = 0; i < keyed.size(); ++i) {
-    if (i == 0 || keyed[i].first != keyed[i - 1].first) group_start.push_back(i);
-  }
-  const std::size_t groups = group_start.size();
-  group_start.push_back(keyed.size());
+  // 1. group candidates by voxel (groups in key order), in input order inside a voxel
+  keys_.resize(points.size());
+  executor_->for_each(points.size(), [&](std::size_t i) { keys_[i] = point_key(points[i], inv_voxel); });
+  const std::size_t groups = grouping_.group(keys_.data(), keys_.size());
+  stats.out_of_range = grouping_.dropped();
+  const std::vector<std::int32_t>& order = grouping_.order();
 
   // 2. find existing voxels, create the missing ones (serially, in key order: voxel_pool.hpp)
   std::vector<std::int32_t> group_voxel(groups);
   {
     const ConstMapView v = view();
     executor_->for_each(groups, [&](std::size_t g) {
-      const std::uint64_t key = keyed[group_start[g]].first;
+      const std::uint64_t key = grouping_.key(g);
       group_voxel[g] = table_find(v, key, spatial_hash(unpack_key(key)));
     });
   }
@@ -110,7 +98,7 @@ InsertStats VoxelMap::insert(const std::vector<Eigen::Vector3f>& points, const E
     std::int32_t rank = 0;
     for (std::size_t g = 0; g < groups; ++g) {
       if (group_voxel[g] >= 0) continue;
-      const std::uint64_t key = keyed[group_start[g]].first;
+      const std::uint64_t key = grouping_.key(g);
       const std::int32_t vox =
           new_voxel_slot(rank++, free_voxels_.data(), free_voxels_.size(), plan.from_free_list, high_water_);
       group_voxel[g] = vox;
@@ -132,11 +120,11 @@ InsertStats VoxelMap::insert(const std::vector<Eigen::Vector3f>& points, const E
   {
     const MapView v = view();
     const auto candidate = [&](std::int64_t c) {
-      return points[static_cast<std::size_t>(keyed[static_cast<std::size_t>(c)].second)];
+      return points[static_cast<std::size_t>(order[static_cast<std::size_t>(c)])];
     };
     executor_->for_each(groups, [&](std::size_t g) {
-      gstats[g] = insert_voxel_group(v, group_voxel[g], candidate, static_cast<std::int64_t>(group_start[g]),
-                                     static_cast<std::int64_t>(group_start[g + 1]), ip, &first_new[g]);
+      gstats[g] = insert_voxel_group(v, group_voxel[g], candidate, static_cast<std::int64_t>(grouping_.start(g)),
+                                     static_cast<std::int64_t>(grouping_.start(g + 1)), ip, &first_new[g]);
     });
   }
   for (const auto& s : gstats) {

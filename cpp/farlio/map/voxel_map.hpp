@@ -5,7 +5,7 @@
 // (CapacityError beyond map.max_voxel_capacity). The decisions of an update (growth, rehash,
 // new voxel slots, removal) are voxel_pool.hpp's, shared with the CUDA backend's DeviceVoxelMap.
 //
-// Updates are deterministic: points are grouped by voxel (sorted by key, then by input order)
+// Updates are deterministic: points are grouped by voxel (in key order, then by input order)
 // and each voxel's candidates are processed in that order by one task, so the map's contents do
 // not depend on the thread count.
 #include <Eigen/Core>
@@ -15,6 +15,7 @@
 
 #include "farlio/core/config.hpp"
 #include "farlio/exec/cpu_executor.hpp"
+#include "farlio/map/key_grouping.hpp"
 #include "farlio/map/map_snapshot.hpp"
 #include "farlio/map/map_view.hpp"
 #include "farlio/map/point_limit.hpp"
@@ -97,6 +98,9 @@ class VoxelMap {
   std::vector<std::int32_t> free_voxels_;
   std::size_t high_water_ = 0;  // voxels [0, high_water_) have been used at least once
   std::size_t live_voxels_ = 0;
+  // insertion scratch, kept across calls
+  std::vector<std::uint64_t> keys_;
+  KeyGrouping grouping_;
 };
 
 }  // namespace farlio::map
