@@ -1,11 +1,15 @@
 """Whole-frame benchmark: farlio's scan pipeline and KISS-ICP on the same scans, in the same
 process and run, one after the other per frame set. Reports per-frame latency (median, p99, max)
-and, when the scans have ground truth, the accuracy of both."""
+and, when the scans have ground truth, the accuracy of both; for farlio also the time of each
+pipeline stage, the work per frame (iterations, points) and the memory (map, peak RSS)."""
 
 from __future__ import annotations
 
+import resource
 import sys
 import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -14,6 +18,23 @@ import farlio
 from farlio import _core
 
 MS_PER_S = 1e3
+P99 = 99
+BYTES_PER_MIB = 2**20
+KIB_PER_MIB = 2**10
+#: getrusage's ru_maxrss counts KiB on Linux, bytes on macOS
+MAXRSS_UNITS_PER_MIB = BYTES_PER_MIB if sys.platform == "darwin" else KIB_PER_MIB
+PERCENT = 100
+#: the stages of FrameResult.timings in pipeline order: name in bench.json -> attribute (seconds)
+STAGES = {
+    "preprocess": "preprocess_s",
+    "covariance": "covariance_s",
+    "registration": "registration_s",
+    "map_update": "map_update_s",
+}
+#: per frame, the whole frame minus its stages (the bindings, the pipeline's own bookkeeping)
+OTHER = "other"
+#: FrameResult counts reported as medians per frame in result["farlio"]["work"]
+WORK_COUNTS = ("iterations", "source_points", "kept_points")
 #: generated urban and handheld sequences start at rest for 2 s: benchmark scans while moving
 GENERATED_SKIP_S = 2.5
 
@@ -38,14 +59,14 @@ def generated_scans(profile: str, scans: int, seed: int = 1) -> tuple[list[Any],
     return out, gt, T
 
 
-def _stats(ms: list[float]) -> dict[str, float]:
+def _median_p99(ms: Sequence[float]) -> dict[str, float]:
     a = np.asarray(ms)
-    return {
-        "median": float(np.median(a)),
-        "p99": float(np.percentile(a, 99)),
-        "max": float(a.max()),
-        "mean": float(a.mean()),
-    }
+    return {"median": float(np.median(a)), "p99": float(np.percentile(a, P99))}
+
+
+def _stats(ms: Sequence[float]) -> dict[str, float]:
+    a = np.asarray(ms)
+    return {**_median_p99(a), "max": float(a.max()), "mean": float(a.mean())}
 
 
 def _accuracy(traj: Any, gt: Any) -> dict[str, float] | None:
@@ -59,18 +80,70 @@ def _accuracy(traj: Any, gt: Any) -> dict[str, float] | None:
     }
 
 
-def run_farlio(scans: list[Any], config: Any) -> tuple[list[float], Any, str]:
-    """(latency per frame in ms, trajectory, the device it ran on)."""
+@dataclass
+class FarlioRun:
+    """What one pass of farlio's scan pipeline over the scans measured, frame by frame."""
+
+    device: str
+    #: whole frame: perf_counter around ScanPipeline.process
+    frame_ms: list[float] = field(default_factory=list)
+    stage_ms: dict[str, list[float]] = field(default_factory=lambda: {s: [] for s in STAGES})
+    work: dict[str, list[int]] = field(default_factory=lambda: {c: [] for c in WORK_COUNTS})
+    trajectory: Any = field(default_factory=farlio.Trajectory)
+    #: map bytes, voxels, points after the last frame and the process's peak RSS (memory_report)
+    memory: dict[str, float] = field(default_factory=dict)
+
+    def add(self, r: Any, ms: float) -> None:
+        """Frame result `r` of ScanPipeline.process, which took `ms` in all."""
+        self.frame_ms.append(ms)
+        for stage, attribute in STAGES.items():
+            self.stage_ms[stage].append(getattr(r.timings, attribute) * MS_PER_S)
+        for count in WORK_COUNTS:
+            self.work[count].append(getattr(r, count))
+        self.trajectory.push_back(r.stamp_ns, r.pose)
+
+    def stage_sums_ms(self) -> np.ndarray:
+        """Per frame, the sum of the stages (they run inside the frame: at most frame_ms)."""
+        return np.sum([self.stage_ms[s] for s in STAGES], axis=0)
+
+
+def memory_report(pipe: Any, last: Any) -> dict[str, float]:
+    """The pipeline's map after frame result `last`, and the peak RSS of this process so far (it
+    includes the scans held in memory and every run before in the same process)."""
+    return {
+        "map_bytes": pipe.map_memory_bytes,
+        "map_voxels": last.map_voxels,
+        "map_points": last.map_points,
+        "peak_rss_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / MAXRSS_UNITS_PER_MIB,
+    }
+
+
+def run_farlio(scans: list[Any], config: Any) -> FarlioRun:
+    """Latency, stage times and work per frame, trajectory, device and memory of farlio's run."""
     pipe = _core.ScanPipeline(config)
     if pipe.device_message:
         print(f"farlio: {pipe.device_message}", file=sys.stderr)
-    ms, traj = [], farlio.Trajectory()
+    run = FarlioRun(pipe.device)
     for s in scans:
         t0 = time.perf_counter()
         r = pipe.process(s)
-        ms.append((time.perf_counter() - t0) * MS_PER_S)
-        traj.push_back(r.stamp_ns, r.pose)
-    return ms, traj, pipe.device
+        run.add(r, (time.perf_counter() - t0) * MS_PER_S)
+    run.memory = memory_report(pipe, r)
+    return run
+
+
+def _farlio_result(run: FarlioRun, gt: Any) -> dict[str, Any]:
+    latency = _stats(run.frame_ms)
+    stages = {s: _median_p99(ms) for s, ms in run.stage_ms.items()}
+    stages[OTHER] = _median_p99(np.asarray(run.frame_ms) - run.stage_sums_ms())
+    return {
+        "latency_ms": latency,
+        "p99_over_median": latency["p99"] / latency["median"],
+        "stages_ms": stages,
+        "work": {c: float(np.median(v)) for c, v in run.work.items()},
+        "memory": run.memory,
+        "accuracy": _accuracy(run.trajectory, gt),
+    }
 
 
 def run_kiss(scans: list[Any], threads: int) -> tuple[list[float], Any]:
@@ -112,13 +185,13 @@ def compare(
     config = _core.Config()
     config.set("num_threads", str(threads))
     config.set("device", device)
-    ms, traj, used = run_farlio(scans, config)
+    run = run_farlio(scans, config)
     result: dict[str, Any] = {
         "frames": len(scans),
         "points_per_scan": float(np.mean([len(s) for s in scans])),
         "threads": threads,
-        "device": used,
-        "farlio": {"latency_ms": _stats(ms), "accuracy": _accuracy(traj, gt)},
+        "device": run.device,
+        "farlio": _farlio_result(run, gt),
     }
     if with_kiss:
         try:
@@ -135,6 +208,11 @@ def compare(
 
 
 def format_table(name: str, r: dict[str, Any]) -> str:
+    """compare's result as text: both systems' latency and accuracy, farlio's stages, work, memory."""
+    return "\n".join([_system_table(name, r), _stage_table(r), _work_line(r), _memory_line(r)])
+
+
+def _system_table(name: str, r: dict[str, Any]) -> str:
     rows = [
         f"{name}: {r['frames']} frames of {r['points_per_scan']:.0f} points, threads={r['threads'] or 'all'}, "
         f"farlio on {r.get('device', 'cpu')}",
@@ -154,3 +232,38 @@ def format_table(name: str, r: dict[str, Any]) -> str:
             f"farlio is {r['speedup_median']:.2f}x faster than KISS-ICP at the median, {r['speedup_p99']:.2f}x at p99"
         )
     return "\n".join(rows)
+
+
+def _stage_row(label: str, ms: dict[str, float], note: str) -> str:
+    return f"{label:14s} {ms['median']:10.2f} {ms['p99']:10.2f}   {note}"
+
+
+def _stage_table(r: dict[str, Any]) -> str:
+    """farlio's stages with their share of the median frame, the whole frame with its p99/median,
+    and KISS-ICP's whole frame with farlio's speed-up at the median and p99."""
+    f = r["farlio"]
+    whole = f["latency_ms"]
+    rows = [f"{'stage':14s} {'median ms':>10s} {'p99 ms':>10s}   share"]
+    for stage, ms in f["stages_ms"].items():
+        rows.append(_stage_row(stage.replace("_", " "), ms, f"{ms['median'] / whole['median'] * PERCENT:4.0f} %"))
+    rows.append(_stage_row("whole frame", whole, f"p99/median {f['p99_over_median']:.2f}"))
+    if "speedup_median" in r:
+        note = f"farlio {r['speedup_median']:.2f}x faster at the median, {r['speedup_p99']:.2f}x at p99"
+        rows.append(_stage_row("KISS-ICP frame", r["kiss_icp"]["latency_ms"], note))
+    return "\n".join(rows)
+
+
+def _work_line(r: dict[str, Any]) -> str:
+    w = r["farlio"]["work"]
+    return (
+        f"work (median per frame): {w['iterations']:.0f} iterations, {w['source_points']:,.0f} source points, "
+        f"{w['kept_points']:,.0f} kept points"
+    )
+
+
+def _memory_line(r: dict[str, Any]) -> str:
+    m = r["farlio"]["memory"]
+    return (
+        f"memory: map {m['map_bytes'] / BYTES_PER_MIB:.1f} MiB ({m['map_voxels']:,} voxels, {m['map_points']:,} "
+        f"points), peak RSS of the process so far {m['peak_rss_mib']:.0f} MiB"
+    )

@@ -19,7 +19,10 @@ COMMANDS = {
     "eval": ("farlio.commands.evaluate", "compare a trajectory with ground truth (APE, RPE, coverage)"),
     "ablate": ("farlio.commands.ablate", "component ablation (EKF, DC, MU, SA GICP, ASMD) on a recording"),
     "latency-sweep": ("farlio.commands.latency_sweep", "APE as the pipeline latency grows (added delays)"),
-    "bench": ("farlio.commands.bench", "whole-frame latency next to KISS-ICP on the same scans"),
+    "bench": (
+        "farlio.commands.bench",
+        "whole-frame latency next to KISS-ICP on the same scans; farlio's stages, work and memory",
+    ),
     "ros2": ("farlio.commands.ros2", "the ROS 2 node: live IMU and PointCloud2 topics in, odometry out (.venv-ros)"),
     "ros2-play": (
         "farlio.commands.ros2_play",

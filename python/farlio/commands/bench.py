@@ -1,10 +1,13 @@
-"""`farlio bench`: whole-frame latency of farlio's scan pipeline next to KISS-ICP, same scans, same run."""
+"""`farlio bench`: whole-frame latency of farlio's scan pipeline next to KISS-ICP, same scans, same run,
+with farlio's stages, work and memory; each data set once per thread count."""
 
 from __future__ import annotations
 
 import argparse
 import json
+from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 from farlio.benchmark import compare, format_table, generated_scans
 from farlio.cli_args import non_negative_int, positive_int
@@ -28,7 +31,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default=[],
         help="also a recording (any format farlio run reads; repeatable)",
     )
-    parser.add_argument("--threads", type=non_negative_int, default=0, help="threads for both systems (0: all)")
+    parser.add_argument(
+        "--threads",
+        type=non_negative_int,
+        nargs="+",
+        metavar="N",
+        default=[0],
+        help="threads for both systems (0: all); several values benchmark each data set once per value, "
+        "keyed '<data set> threads=<n>' in bench.json",
+    )
     parser.add_argument(
         "--device",
         choices=DEVICES,
@@ -36,20 +47,37 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="farlio's backend: auto (the GPU when present, else the CPU with a message), cpu, cuda",
     )
     parser.add_argument("--no-kiss", action="store_true", help="farlio only (KISS-ICP: pip install kiss-icp)")
-    parser.add_argument("--out", type=Path, default=None, help="folder for bench.json (optional)")
+    parser.add_argument(
+        "--out",
+        type=Path,
+        default=None,
+        help="folder for bench.json (optional): latency, stages_ms, work, memory, accuracy per data set",
+    )
+
+
+def _data_sets(args: argparse.Namespace) -> Iterator[tuple[str, list[Any], Any]]:
+    """(name, scans, ground truth or None) of each generated profile, then of each recording."""
+    for profile in args.profile or ([] if args.data else ["urban"]):
+        scans, gt, _ = generated_scans(profile, args.scans)
+        yield profile, scans, gt
+    for path in args.data:
+        ds = open_dataset(path)
+        yield str(path), [ds.scan(i) for i in range(min(len(ds), args.scans))], None
+
+
+def result_key(name: str, threads: int, several: bool) -> str:
+    """bench.json's key of a data set: its name, with the thread count when several were asked for."""
+    return f"{name} threads={threads}" if several else name
 
 
 def run(args: argparse.Namespace) -> int:
     results = {}
-    for profile in args.profile or ([] if args.data else ["urban"]):
-        scans, gt, _ = generated_scans(profile, args.scans)
-        results[profile] = compare(scans, gt, threads=args.threads, with_kiss=not args.no_kiss, device=args.device)
-        print(format_table(profile, results[profile]), flush=True)
-    for path in args.data:
-        ds = open_dataset(path)
-        scans = [ds.scan(i) for i in range(min(len(ds), args.scans))]
-        results[str(path)] = compare(scans, None, threads=args.threads, with_kiss=not args.no_kiss, device=args.device)
-        print(format_table(str(path), results[str(path)]), flush=True)
+    thread_counts = list(dict.fromkeys(args.threads))  # each count once, in the order given
+    for name, scans, gt in _data_sets(args):
+        for threads in thread_counts:
+            key = result_key(name, threads, len(thread_counts) > 1)
+            results[key] = compare(scans, gt, threads=threads, with_kiss=not args.no_kiss, device=args.device)
+            print(format_table(name, results[key]), flush=True)
     if args.out:
         args.out.mkdir(parents=True, exist_ok=True)
         (args.out / "bench.json").write_text(json.dumps(results, indent=2))

@@ -1,0 +1,96 @@
+"""`farlio bench`: farlio's stage breakdown nests in the whole frame, several --threads values give
+one bench.json entry each, the work and memory fields are filled, and --help documents every
+option. Few generated scans and --no-kiss: these check what the benchmark reports, never how fast
+anything is (timings belong in benchmarks)."""
+
+from __future__ import annotations
+
+import argparse
+import io
+import json
+from contextlib import redirect_stdout
+
+import numpy as np
+import pytest
+
+pytest.importorskip("farlio._core")
+
+from farlio import _core  # noqa: E402
+from farlio.benchmark import OTHER, STAGES, WORK_COUNTS, generated_scans, run_farlio  # noqa: E402
+from farlio.cli import build_parser, main  # noqa: E402
+
+PROFILE = "handheld"  # the smaller generated scans: a fast test
+SCANS = 5
+THREADS = (1, 2)
+BENCH = ["bench", "--profile", PROFILE, "--scans", str(SCANS), "--no-kiss", "--device", "cpu"]
+#: the stages run inside the timed frame: per frame their sum stays within it, up to clock jitter
+FRAME_FACTOR = 1.05
+FRAME_SLACK_MS = 0.2
+MEMORY_FIELDS = ("map_bytes", "map_voxels", "map_points", "peak_rss_mib")
+
+
+@pytest.fixture(scope="module")
+def two_thread_counts(tmp_path_factory) -> tuple[dict, str]:
+    """bench.json and the printed text of one bench with two --threads values."""
+    out, text = tmp_path_factory.mktemp("bench"), io.StringIO()
+    with redirect_stdout(text):
+        assert main(BENCH + ["--threads", *map(str, THREADS), "--out", str(out)]) == 0
+    return json.loads((out / "bench.json").read_text()), text.getvalue()
+
+
+def test_stages_sum_to_at_most_the_whole_frame():
+    scans, _, _ = generated_scans(PROFILE, SCANS)
+    config = _core.Config()
+    config.set("device", "cpu")
+    run = run_farlio(scans, config)
+    frame_ms = np.asarray(run.frame_ms)
+    sums = run.stage_sums_ms()
+    assert sums.shape == frame_ms.shape == (SCANS,)
+    assert np.all(sums > 0), sums
+    assert np.all(sums <= frame_ms * FRAME_FACTOR + FRAME_SLACK_MS), (sums, frame_ms)
+
+
+def test_two_thread_counts_give_one_entry_each(two_thread_counts):
+    results, _ = two_thread_counts
+    assert set(results) == {f"{PROFILE} threads={t}" for t in THREADS}
+    for t in THREADS:
+        assert results[f"{PROFILE} threads={t}"]["threads"] == t
+
+
+def test_stage_medians_are_positive_and_within_their_p99(two_thread_counts):
+    results, _ = two_thread_counts
+    for r in results.values():
+        stages = r["farlio"]["stages_ms"]
+        assert set(stages) == {*STAGES, OTHER}
+        for stage in STAGES:
+            assert 0 < stages[stage]["median"] <= stages[stage]["p99"], (stage, stages[stage])
+        latency = r["farlio"]["latency_ms"]
+        assert sum(stages[s]["median"] for s in STAGES) <= latency["median"] * FRAME_FACTOR + FRAME_SLACK_MS
+        assert r["farlio"]["p99_over_median"] == pytest.approx(latency["p99"] / latency["median"])
+
+
+def test_work_and_memory_are_reported(two_thread_counts):
+    results, text = two_thread_counts
+    for r in results.values():
+        work, memory = r["farlio"]["work"], r["farlio"]["memory"]
+        assert set(work) == set(WORK_COUNTS)
+        assert work["iterations"] > 0
+        assert 0 < work["source_points"] <= work["kept_points"] < r["points_per_scan"]
+        for name in MEMORY_FIELDS:
+            assert memory[name] > 0, (name, memory)
+    for heading in ("stage", "preprocess", "map update", "whole frame", "p99/median", "work (median", "memory: map"):
+        assert text.count(heading) >= len(THREADS), heading
+
+
+def test_one_thread_count_keeps_the_plain_key(tmp_path):
+    assert main(BENCH + ["--out", str(tmp_path)]) == 0
+    results = json.loads((tmp_path / "bench.json").read_text())
+    assert list(results) == [PROFILE]
+    assert results[PROFILE]["threads"] == 0
+
+
+def test_help_documents_every_option():
+    parser = build_parser()
+    bench = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction)).choices["bench"]
+    for action in bench._actions:
+        assert action.help and action.help != argparse.SUPPRESS, action.option_strings
