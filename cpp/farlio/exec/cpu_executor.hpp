@@ -18,12 +18,13 @@ class CpuExecutor {
 
   [[nodiscard]] int num_threads() const { return arena_.max_concurrency(); }
 
-  /// Calls body(i) for every i in [0, n).
+  /// Calls body(i) for every i in [0, n), in tasks of at least `grain` indices (smaller for
+  /// bodies of uneven cost, such as one voxel's points).
   template <typename Body>
-  void for_each(std::size_t n, const Body& body) {
+  void for_each(std::size_t n, const Body& body, std::size_t grain = kGrain) {
     if (n == 0) return;
     arena_.execute([&] {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kGrain), [&](const tbb::blocked_range<std::size_t>& r) {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, grain), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i < r.end(); ++i) body(i);
       });
     });

@@ -13,6 +13,9 @@
 namespace farlio::map {
 namespace {
 constexpr const char* kCapacityParameter = "map.max_voxel_capacity";
+/// Voxels per task of the per-voxel loops: a voxel holds 1 to N_max points, so tasks of a few
+/// voxels balance the threads (a map of a few hundred voxels would otherwise make 2 or 3 tasks).
+constexpr std::size_t kVoxelGrain = 8;
 }  // namespace
 
 double point_spacing_m(const VoxelMapConfig& config) {
@@ -122,10 +125,13 @@ InsertStats VoxelMap::insert(const std::vector<Eigen::Vector3f>& points, const E
     const auto candidate = [&](std::int64_t c) {
       return points[static_cast<std::size_t>(order[static_cast<std::size_t>(c)])];
     };
-    executor_->for_each(groups, [&](std::size_t g) {
-      gstats[g] = insert_voxel_group(v, group_voxel[g], candidate, static_cast<std::int64_t>(grouping_.start(g)),
-                                     static_cast<std::int64_t>(grouping_.start(g + 1)), ip, &first_new[g]);
-    });
+    executor_->for_each(
+        groups,
+        [&](std::size_t g) {
+          gstats[g] = insert_voxel_group(v, group_voxel[g], candidate, static_cast<std::int64_t>(grouping_.start(g)),
+                                         static_cast<std::int64_t>(grouping_.start(g + 1)), ip, &first_new[g]);
+        },
+        kVoxelGrain);
   }
   for (const auto& s : gstats) {
     stats.inserted += static_cast<std::size_t>(s.inserted);
@@ -148,9 +154,10 @@ InsertStats VoxelMap::insert(const std::vector<Eigen::Vector3f>& points, const E
   const int k = config_.covariance_neighbors;
   const auto eps = static_cast<float>(config_.covariance_epsilon);
   const auto line_ratio = static_cast<float>(config_.line_eigenvalue_ratio);
-  executor_->for_each(cov_voxels.size(), [&](std::size_t i) {
-    update_voxel_covariances(v, cov_voxels[i], cov_points[i], k, eps, line_ratio);
-  });
+  executor_->for_each(
+      cov_voxels.size(),
+      [&](std::size_t i) { update_voxel_covariances(v, cov_voxels[i], cov_points[i], k, eps, line_ratio); },
+      kVoxelGrain);
   return stats;
 }
 
