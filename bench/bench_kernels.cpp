@@ -3,9 +3,12 @@
 // The thread count is a benchmark argument (the pipeline's own arena, no global setting).
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <limits>
 #include <memory>
 #include <numeric>
+#include <random>
+#include <utility>
 
 #include "farlio/map/neighbor_search.hpp"
 #include "farlio/map/voxel_map.hpp"
@@ -91,15 +94,58 @@ struct MapFixture {
   }
 };
 
+/// Points a nearest-neighbour search compares (the same pruning as map::nearest_neighbor).
+double nn_candidates(const map::ConstMapView& v, const Eigen::Vector3f& p, float max_distance2) {
+  float best = max_distance2;
+  double candidates = 0;
+  map::for_each_nearby_voxel(
+      v, p, [&] { return best; },
+      [&](std::int32_t vox) {
+        for (std::int32_t j = 0; j < v.voxel_counts[vox]; ++j) {
+          ++candidates;
+          best = std::min(best, (v.points[v.point_index(vox, j)].head<3>() - p).squaredNorm());
+        }
+      });
+  return candidates;
+}
+
 void BM_NearestNeighbor(benchmark::State& state) {
   MapFixture f(static_cast<int>(state.range(0)));
   const map::MapView v = f.map.view();
+  double candidates = 0;
+  for (const auto& q : f.queries) candidates += nn_candidates(v, q, 9.0f);
+  state.counters["candidates_per_query"] = candidates / static_cast<double>(f.queries.size());
   std::vector<std::int64_t> out(f.queries.size());
   for (auto _ : state) {
     f.ex.for_each(f.queries.size(), [&](std::size_t i) { out[i] = map::nearest_neighbor(v, f.queries[i], 9.0f); });
     benchmark::DoNotOptimize(out.data());
   }
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(f.queries.size()));
+}
+
+/// Points and voxels the k-nearest-neighbour searches of a map's covariances compare and visit,
+/// per query (the walk of update_voxel_covariances, counted).
+std::pair<double, double> knn_work(const map::ConstMapView& v, std::size_t voxels, int k) {
+  double candidates = 0, visited = 0, queries = 0;
+  std::int64_t idx[map::kMaxNeighbors];
+  float d2[map::kMaxNeighbors];
+  for (std::size_t vox = 0; vox < voxels; ++vox) {
+    if (v.voxel_keys[vox] == map::kEmptyKey) continue;
+    const map::VoxelNeighborhood nb = map::voxel_neighborhood(v, map::unpack_key(v.voxel_keys[vox]));
+    for (std::int32_t j = 0; j < v.voxel_counts[vox]; ++j) {
+      const Eigen::Vector3f p = v.points[v.point_index(static_cast<std::int32_t>(vox), j)].head<3>();
+      const auto counting_walk = [&](const auto& bound, const auto& visit) {
+        map::for_each_nearby_voxel(v, nb, p, bound, [&](std::int32_t w) {
+          ++visited;
+          candidates += v.voxel_counts[w];
+          visit(w);
+        });
+      };
+      map::knn_over(v, counting_walk, p, k, map::kUnboundedDistance2, idx, d2);
+      ++queries;
+    }
+  }
+  return {candidates / queries, visited / queries};
 }
 
 void BM_CovarianceKnn(benchmark::State& state) {
@@ -109,6 +155,14 @@ void BM_CovarianceKnn(benchmark::State& state) {
   VoxelMapConfig cfg;
   cfg.point_spacing_m = map::point_spacing_m(cfg);
   cfg.max_points_per_voxel = 20;
+  {
+    map::VoxelMap m(cfg, ex);
+    m.insert(pts, Eigen::Vector3f::Zero(), map::PointLimit::constant(20));
+    const auto [candidates, visited] = knn_work(m.view(), m.voxel_capacity(), cfg.covariance_neighbors);
+    state.counters["points"] = static_cast<double>(m.num_points());
+    state.counters["candidates_per_query"] = candidates;
+    state.counters["voxels_per_query"] = visited;
+  }
   for (auto _ : state) {
     state.PauseTiming();
     map::VoxelMap m(cfg, ex);
@@ -153,8 +207,101 @@ void BM_WholeFrame(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(scans.front().size()));
 }
 
+// ---- the machine's limits, the yardsticks of docs/performance.md ----------------------------
+
+constexpr std::size_t kStreamBytes = std::size_t{256} << 20;  // far beyond the caches
+constexpr std::size_t kChaseBytes = std::size_t{64} << 20;
+constexpr std::size_t kL2TableBytes = std::size_t{512} << 10;  // a hash table that stays in L2
+
+/// Memory read bandwidth: a sum over a 256 MiB array (bytes_per_second).
+void BM_MemoryRead(benchmark::State& state) {
+  exec::CpuExecutor ex(static_cast<int>(state.range(0)));
+  const std::vector<float> data(kStreamBytes / sizeof(float), 1.0f);
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(ex.reduce(
+        data.size() / 1024, 0.0f,
+        [&](std::size_t b) {
+          float acc = 0.0f;
+          for (std::size_t i = b * 1024; i < (b + 1) * 1024; ++i) acc += data[i];
+          return acc;
+        },
+        [](float a, float b) { return a + b; }));
+  }
+  state.SetBytesProcessed(state.iterations() * static_cast<std::int64_t>(kStreamBytes));
+}
+
+/// A cache miss to memory: dependent loads along a random cycle over 64 MiB (time per load).
+void BM_MemoryLatency(benchmark::State& state) {
+  const std::size_t n = kChaseBytes / sizeof(std::uint32_t);
+  std::vector<std::uint32_t> next(n);
+  std::vector<std::uint32_t> perm(n);
+  std::iota(perm.begin(), perm.end(), 0u);
+  std::shuffle(perm.begin() + 1, perm.end(), std::mt19937(1));
+  for (std::size_t i = 0; i < n; ++i) next[perm[i]] = perm[(i + 1) % n];
+  constexpr std::int64_t kLoads = 1 << 20;
+  std::uint32_t at = 0;
+  for (auto _ : state) {
+    for (std::int64_t i = 0; i < kLoads; ++i) at = next[at];
+    benchmark::DoNotOptimize(at);
+  }
+  state.SetItemsProcessed(state.iterations() * kLoads);
+}
+
+/// Independent random probes of a 512 KiB table (a hash table held in L2), per thread count.
+void BM_L2Probes(benchmark::State& state) {
+  exec::CpuExecutor ex(static_cast<int>(state.range(0)));
+  const std::size_t n = kL2TableBytes / sizeof(std::uint64_t);
+  std::vector<std::uint64_t> table(n, 1);
+  constexpr std::size_t kProbes = 1 << 20;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(ex.reduce(
+        kProbes / 1024, std::uint64_t{0},
+        [&](std::size_t b) {
+          std::uint64_t acc = 0, h = b;
+          for (std::size_t i = 0; i < 1024; ++i) {
+            h = h * 0x9E3779B97F4A7C15ULL + 1;
+            acc += table[(h >> 40) & (n - 1)];
+          }
+          return acc;
+        },
+        [](std::uint64_t a, std::uint64_t b) { return a + b; }));
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(kProbes));
+}
+
+/// Point-to-query squared distances over points held in L1 (the searches' inner loop,
+/// block_distances2), per thread count: the rate that bounds the neighbour searches.
+void BM_L1Distances(benchmark::State& state) {
+  exec::CpuExecutor ex(static_cast<int>(state.range(0)));
+  constexpr std::int32_t kPoints = 320;  // 16 voxels' worth of a frame map: 5 KiB
+  constexpr std::size_t kQueries = 1 << 14;
+  std::vector<Eigen::Vector4f> points(kPoints);
+  for (std::int32_t i = 0; i < kPoints; ++i) points[static_cast<std::size_t>(i)] = Eigen::Vector4f::Random();
+  map::ConstMapView v;
+  v.points = points.data();
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(ex.reduce(
+        kQueries, 0.0f,
+        [&](std::size_t q) {
+          const Eigen::Vector3f p = Eigen::Vector3f::Constant(static_cast<float>(q) * 1e-4f);
+          float best = 1e30f, d2[map::kDistanceBlock];
+          for (std::int32_t j0 = 0; j0 < kPoints; j0 += map::kDistanceBlock) {
+            const std::int32_t len = map::block_distances2(v, j0, kPoints - j0, p, d2);
+            for (std::int32_t j = 0; j < len; ++j) best = std::min(best, d2[j]);
+          }
+          return best;
+        },
+        [](float a, float b) { return std::min(a, b); }));
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(kQueries) * kPoints);
+}
+
 }  // namespace
 
+BENCHMARK(BM_L1Distances)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_MemoryRead)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_MemoryLatency)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_L2Probes)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Downsample)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_MapInsert)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_NearestNeighbor)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);

@@ -1,10 +1,10 @@
 #pragma once
 // Downsampling to one point per cell: the first point (lowest index) of each cell, found with
-// a hash table of the cells on the CPU executor instead of a sort of all points. A scan of
-// ~120k points falls into ~10k cells of the map spacing; sorting the points by cell cost more
-// than all the other preprocessing (docs/performance.md), while one probe of a table that
-// stays in cache per point, skipped when the point's neighbour in the scan order fell into the
-// same cell, is close to the cost of reading the keys.
+// hash tables of the cells on the CPU executor instead of a sort of all points. A scan of ~120k
+// points falls into ~10k cells of the map spacing; sorting the points by cell cost more than all
+// the other preprocessing (docs/performance.md). Each thread deduplicates a contiguous block of
+// the scan into its own table (no atomics, no cache line shared between cores), skipping a point
+// whose neighbour in the scan order fell into the same cell; the tables are then merged.
 #include <cstddef>
 #include <cstdint>
 #include <utility>
@@ -13,6 +13,25 @@
 #include "farlio/exec/cpu_executor.hpp"
 
 namespace farlio::pipeline {
+
+/// An open-addressing table cell key -> lowest index seen, owned by one thread at a time.
+class CellTable {
+ public:
+  /// Empties the table and gives it room for about `expected_cells` cells.
+  void reset(std::size_t expected_cells);
+  /// Records `index` for `key` (keeps the lowest); grows when half full.
+  void insert_min(std::uint64_t key, std::int32_t index);
+  /// Appends every (key, lowest index) to `out` and empties the table.
+  void drain(std::vector<std::pair<std::uint64_t, std::int32_t>>& out);
+  [[nodiscard]] std::size_t cells() const { return cells_; }
+
+ private:
+  void grow();
+
+  std::vector<std::uint64_t> keys_;
+  std::vector<std::int32_t> first_;
+  std::size_t cells_ = 0;
+};
 
 class CellDownsampler {
  public:
@@ -23,17 +42,10 @@ class CellDownsampler {
                                                       exec::CpuExecutor& executor);
 
  private:
-  /// Inserts the keys into a table of `slots` slots; false when it filled beyond half (the
-  /// table is then cleared and the caller retries with a larger one).
-  bool fill_table(const std::uint64_t* keys, std::size_t n, std::size_t slots, exec::CpuExecutor& executor);
-  /// Moves the table's cells into cells_ and empties the table.
-  void drain_table();
-
-  std::vector<std::uint64_t> slot_keys_;
-  std::vector<std::int32_t> slot_first_;
+  std::vector<CellTable> tables_;  // one per block of the scan (a block per thread)
   std::vector<std::pair<std::uint64_t, std::int32_t>> cells_;
   std::vector<std::int32_t> kept_;
-  std::size_t expected_cells_ = 0;  // cells of the previous call: sizes the table
+  std::size_t expected_cells_ = 0;  // cells of the previous call: sizes the tables
 };
 
 }  // namespace farlio::pipeline
