@@ -25,6 +25,8 @@ GENERATED_SCANS = 60
 #: frames skipped per run: the first has no map, the second no velocity yet
 WARMUP_FRAMES = 2
 
+#: the worker reads FrameResult.timings directly instead of calling farlio.benchmark.run_farlio,
+#: so that it runs on builds from before that function gave stage times
 WORKER = r"""
 import json, sys, time
 from farlio import _core

@@ -128,9 +128,26 @@ TEST(SharedBodies, PerVoxelCovariancesEqualThePerPointBodyOfCuda) {
   EXPECT_GT(with_covariance, compared / 2);
 }
 
+namespace {
+
+/// Squared distance from p to the box of voxel c, axis by axis (the form the searches used
+/// before BlockDistances).
+float voxel_box_distance2(const Eigen::Vector3f& p, const map::VoxelCoord& c, float voxel_size) {
+  float d2 = 0.0f;
+  for (int a = 0; a < 3; ++a) {
+    const float lo = static_cast<float>(c[a]) * voxel_size;
+    const float hi = lo + voxel_size;
+    const float d = p[a] < lo ? lo - p[a] : (p[a] > hi ? p[a] - hi : 0.0f);
+    d2 += d * d;
+  }
+  return d2;
+}
+
+}  // namespace
+
 TEST(SharedBodies, BlockDistancesEqualTheBoxDistanceOfEachVoxel) {
-  // the neighbour searches prune voxels with BlockDistances: the same floats as
-  // voxel_box_distance2, so the voxels visited (and the matches) do not change
+  // the neighbour searches prune voxels with BlockDistances: the same floats as the box
+  // distance per voxel, so the voxels visited (and the matches) do not change
   std::mt19937 rng(11);
   std::uniform_real_distribution<float> u(-300.0f, 300.0f);
   for (float voxel : {4.0f, 1.0f, 0.37f}) {
@@ -139,7 +156,7 @@ TEST(SharedBodies, BlockDistancesEqualTheBoxDistanceOfEachVoxel) {
       const map::VoxelCoord c0 = map::voxel_of(p, 1.0f / voxel);
       const map::BlockDistances box(p, c0, voxel);
       for (int n = 0; n < map::kNeighborVoxels; ++n) {
-        ASSERT_EQ(box.distance2(n), map::voxel_box_distance2(p, map::neighbor_voxel(c0, n), voxel)) << n;
+        ASSERT_EQ(box.distance2(n), voxel_box_distance2(p, map::neighbor_voxel(c0, n), voxel)) << n;
       }
       EXPECT_EQ(box.distance2(0), 0.0f);
     }

@@ -30,17 +30,6 @@ class CpuExecutor {
     });
   }
 
-  /// Calls body(begin, end) for consecutive ranges that cover [0, n) (for loops that carry
-  /// state from one index to the next inside a range).
-  template <typename Body>
-  void for_each_range(std::size_t n, const Body& body) {
-    if (n == 0) return;
-    arena_.execute([&] {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kGrain),
-                        [&](const tbb::blocked_range<std::size_t>& r) { body(r.begin(), r.end()); });
-    });
-  }
-
   /// Sum over i in [0, n) of map(i), combined with `combine` (associative), starting from
   /// `identity`. Deterministic for a given thread count and n (static partitioning).
   template <typename T, typename Map, typename Combine>

@@ -11,8 +11,6 @@ namespace {
 
 constexpr std::size_t kMinSlots = 1024;
 constexpr std::size_t kSlotsPerIndex = 2;  // at most half full even when every key differs
-constexpr std::uint64_t kHashMultiplier = 0x9E3779B97F4A7C15ULL;
-constexpr int kHashShift = 20;
 
 }  // namespace
 
@@ -35,7 +33,7 @@ std::size_t KeyGrouping::group(const std::uint64_t* keys, std::size_t n) {
       ++dropped_;
       continue;
     }
-    std::size_t s = static_cast<std::size_t>((key * kHashMultiplier) >> kHashShift) & mask;
+    std::size_t s = packed_key_slot(key, mask);
     while (slot_keys_[s] != key && slot_keys_[s] != kEmptyKey) s = (s + 1) & mask;
     if (slot_keys_[s] == kEmptyKey) {
       slot_keys_[s] = key;
@@ -63,7 +61,7 @@ std::size_t KeyGrouping::group(const std::uint64_t* keys, std::size_t n) {
     group_start_[r + 1] = group_start_[r] + counts_[g];
   }
   for (const std::uint64_t key : first_seen_) {
-    std::size_t s = static_cast<std::size_t>((key * kHashMultiplier) >> kHashShift) & mask;
+    std::size_t s = packed_key_slot(key, mask);
     while (slot_keys_[s] != key) s = (s + 1) & mask;
     slot_keys_[s] = kEmptyKey;
   }

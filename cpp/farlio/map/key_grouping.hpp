@@ -14,7 +14,6 @@ class KeyGrouping {
   /// Groups the indices i in [0, n) with keys[i] != kEmptyKey; returns the number of groups.
   std::size_t group(const std::uint64_t* keys, std::size_t n);
 
-  [[nodiscard]] std::size_t groups() const { return group_keys_.size(); }
   /// Key of group g (ascending in g).
   [[nodiscard]] std::uint64_t key(std::size_t g) const { return group_keys_[g]; }
   /// The members of group g are order()[start(g)] .. order()[start(g + 1) - 1].

@@ -17,18 +17,6 @@ inline constexpr int kMaxNeighbors = 32;
 /// vectorises, then the comparisons).
 inline constexpr int kDistanceBlock = 16;
 
-/// Squared distance from p to the box of voxel c (0 inside).
-FARLIO_HD inline float voxel_box_distance2(const Eigen::Vector3f& p, const VoxelCoord& c, float voxel_size) {
-  float d2 = 0.0f;
-  for (int a = 0; a < 3; ++a) {
-    const float lo = static_cast<float>(c[a]) * voxel_size;
-    const float hi = lo + voxel_size;
-    const float d = p[a] < lo ? lo - p[a] : (p[a] > hi ? p[a] - hi : 0.0f);
-    d2 += d * d;
-  }
-  return d2;
-}
-
 /// Squared distances from p to the points [first, first + min(remaining, kDistanceBlock)) of the
 /// pool, into d2; returns how many.
 FARLIO_HD inline std::int32_t block_distances2(const ConstMapView& m, std::int64_t first, std::int32_t remaining,
@@ -58,8 +46,8 @@ FARLIO_HD inline VoxelCoord neighbor_voxel(const VoxelCoord& c0, int n) {
   return {c0.x() + code % 3 - 1, c0.y() + (code / 3) % 3 - 1, c0.z() + code / 9 - 1};
 }
 
-/// voxel_box_distance2 from p to each voxel of the block around c0, from 9 distances along the
-/// axes computed once per query instead of 3 per voxel (the same floats in the same sums).
+/// Squared distance from p to the box of each voxel of the block around c0 (0 inside), from 9
+/// distances along the axes computed once per query instead of 3 per voxel.
 struct BlockDistances {
   float along[3][3];  ///< [axis][offset + 1]: distance from p to that slab along the axis
 

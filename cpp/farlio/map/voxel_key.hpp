@@ -3,6 +3,7 @@
 // the hash named in the paper). Shared by the CPU and CUDA backends.
 #include <Eigen/Core>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 
 #include "farlio/exec/hd.hpp"
@@ -51,6 +52,15 @@ FARLIO_HD inline std::uint64_t spatial_hash(const VoxelCoord& c) {
   x *= 0x45d9f3bULL;
   x ^= x >> 16;
   return x;
+}
+
+/// The home slot of a packed key in an open-addressing table of mask + 1 slots (a power of two)
+/// of the host's scratch tables (downsampling cells, voxel grouping): Fibonacci hashing of the
+/// key's bits, cheaper than unpacking it for spatial_hash.
+inline std::size_t packed_key_slot(std::uint64_t key, std::size_t mask) {
+  constexpr std::uint64_t kMultiplier = 0x9E3779B97F4A7C15ULL;
+  constexpr int kShift = 20;
+  return static_cast<std::size_t>((key * kMultiplier) >> kShift) & mask;
 }
 
 }  // namespace farlio::map

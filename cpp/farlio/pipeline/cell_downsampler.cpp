@@ -13,14 +13,6 @@ namespace {
 constexpr std::size_t kMinSlots = std::size_t{1} << 10;
 /// Slots per expected cell (the previous scan's count): the table starts a quarter full.
 constexpr std::size_t kSlotsPerExpectedCell = 4;
-/// Fibonacci hashing of a packed key (its bits are three axis coordinates side by side).
-constexpr std::uint64_t kHashMultiplier = 0x9E3779B97F4A7C15ULL;
-constexpr int kHashShift = 20;
-
-std::size_t slot_of(std::uint64_t key, std::size_t mask) {
-  return static_cast<std::size_t>((key * kHashMultiplier) >> kHashShift) & mask;
-}
-
 }  // namespace
 
 void CellTable::reset(std::size_t expected_cells) {
@@ -34,7 +26,7 @@ void CellTable::reset(std::size_t expected_cells) {
 
 void CellTable::insert_min(std::uint64_t key, std::int32_t index) {
   const std::size_t mask = keys_.size() - 1;
-  std::size_t s = slot_of(key, mask);
+  std::size_t s = map::packed_key_slot(key, mask);
   while (keys_[s] != key && keys_[s] != map::kEmptyKey) s = (s + 1) & mask;
   if (keys_[s] == key) {
     first_[s] = std::min(first_[s], index);

@@ -23,7 +23,6 @@ class CellTable {
   void insert_min(std::uint64_t key, std::int32_t index);
   /// Appends every (key, lowest index) to `out` and empties the table.
   void drain(std::vector<std::pair<std::uint64_t, std::int32_t>>& out);
-  [[nodiscard]] std::size_t cells() const { return cells_; }
 
  private:
   void grow();

@@ -53,10 +53,7 @@ LinearSystem build_linear_system(const SourceCloud& source, const map::ConstMapV
 RegistrationResult register_scan(const SourceCloud& source, const map::ConstMapView& target, const SE3& initial_guess,
                                  const Thresholds& th, const RegistrationConfig& config, double time_budget_s,
                                  exec::CpuExecutor& executor) {
-  if (config.correspondence_reuse_m <= 0.0) {
-    return gauss_newton([&](const SE3& T) { return build_linear_system(source, target, T, th, config, executor); },
-                        initial_guess, config, time_budget_s);
-  }
+  // with correspondence_reuse_m = 0 every point is searched at every iteration
   std::vector<Correspondence> matches(source.size());
   const auto reuse2 = static_cast<float>(config.correspondence_reuse_m * config.correspondence_reuse_m);
   const auto build = [&](const SE3& T) {

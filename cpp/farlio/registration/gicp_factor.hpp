@@ -103,7 +103,7 @@ FARLIO_HD inline bool gicp_factor_reusing(const map::ConstMapView& m, const Eige
                                           const FactorParams& fp, float reuse_distance2, Correspondence& c,
                                           FactorTerms& out) {
   const Eigen::Vector3f p = fp.R * s.head<3>() + fp.t;
-  if (!c.valid || (p - c.searched_at).squaredNorm() >= reuse_distance2) {
+  if (!c.valid || !((p - c.searched_at).squaredNorm() < reuse_distance2)) {
     c.nn = map::nearest_neighbor(m, p, fp.max_correspondence_distance2);
     c.searched_at = p;
     c.valid = true;
