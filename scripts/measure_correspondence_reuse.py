@@ -65,9 +65,8 @@ def main() -> int:
     for path in args.data:
         ds = open_dataset(path)
         sets.append((path, [ds.scan(i) for i in range(len(ds))], None))
-    print(
-        f"{'data':28s} {'reuse m':>7s} {'frame ms':>9s} {'reg ms':>7s} {'APE m':>8s} {'RPE %':>7s} {'max |dpos| mm':>14s}"
-    )
+    columns = f"{'reuse m':>7s} {'frame ms':>9s} {'reg ms':>7s} {'APE m':>8s} {'RPE %':>7s} {'max |dpos| mm':>14s}"
+    print(f"{'data':28s} {columns}")
     for name, scans, gt in sets:
         base = None
         for reuse in REUSE_M:
