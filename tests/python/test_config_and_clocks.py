@@ -237,8 +237,16 @@ def wait_for_rows(path: Path, rows: int, process: subprocess.Popen) -> None:
 @pytest.mark.parametrize("sig,code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
 def test_an_interrupted_run_keeps_its_summary_and_kitti_poses(sequence, tmp_path, sig, code):
     out = tmp_path / "out"
-    # every registration runs its 50 iterations: frames slow enough to interrupt mid-run
-    slow = ["--set", "registration.convergence_norm=1e-300", "--set", "registration.max_iterations=50"]
+    # every registration runs its 50 iterations, each with its own searches (a kept match would make
+    # the iterations after the first cheap): frames slow enough to interrupt mid-run
+    slow = [
+        "--set",
+        "registration.convergence_norm=1e-300",
+        "--set",
+        "registration.max_iterations=50",
+        "--set",
+        "registration.correspondence_reuse_m=0",
+    ]
     cmd = [sys.executable, "-m", "farlio.cli", "run", str(sequence), "--out", str(out), "--no-plot", "--no-progress"]
     process = subprocess.Popen([*cmd, *slow, "--threads", "1"], stderr=subprocess.PIPE, text=True)
     try:
