@@ -28,6 +28,8 @@ IMU_OFFSET_S = 2
 #: how long the interrupt test waits for frames before and for the exit after the signal (s)
 RUN_START_TIMEOUT_S = 120
 EXIT_TIMEOUT_S = 60
+#: the interrupted run's sequence (s): ~8 s of slowed frames here, of which the test waits for 3
+INTERRUPTED_RUN_S = 10.0
 #: an accelerometer at rest, z up (m/s^2)
 GRAVITY_UP = np.array([0.0, 0.0, 9.81])
 
@@ -36,6 +38,14 @@ GRAVITY_UP = np.array([0.0, 0.0, 9.81])
 def sequence(tmp_path_factory):
     path = tmp_path_factory.mktemp("seq") / "urban"
     generate("urban", path, duration_s=3.0)
+    return path
+
+
+@pytest.fixture(scope="module")
+def long_sequence(tmp_path_factory):
+    """100 frames: the interrupt test's run lasts seconds after its third frame on any machine."""
+    path = tmp_path_factory.mktemp("seq") / "urban_long"
+    generate("urban", path, duration_s=INTERRUPTED_RUN_S)
     return path
 
 
@@ -235,7 +245,7 @@ def wait_for_rows(path: Path, rows: int, process: subprocess.Popen) -> None:
 
 
 @pytest.mark.parametrize("sig,code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
-def test_an_interrupted_run_keeps_its_summary_and_kitti_poses(sequence, tmp_path, sig, code):
+def test_an_interrupted_run_keeps_its_summary_and_kitti_poses(long_sequence, tmp_path, sig, code):
     out = tmp_path / "out"
     # every registration runs its 50 iterations, each with its own searches (a kept match would make
     # the iterations after the first cheap): frames slow enough to interrupt mid-run
@@ -247,7 +257,8 @@ def test_an_interrupted_run_keeps_its_summary_and_kitti_poses(sequence, tmp_path
         "--set",
         "registration.correspondence_reuse_m=0",
     ]
-    cmd = [sys.executable, "-m", "farlio.cli", "run", str(sequence), "--out", str(out), "--no-plot", "--no-progress"]
+    seq = str(long_sequence)
+    cmd = [sys.executable, "-m", "farlio.cli", "run", seq, "--out", str(out), "--no-plot", "--no-progress"]
     process = subprocess.Popen([*cmd, *slow, "--threads", "1"], stderr=subprocess.PIPE, text=True)
     try:
         wait_for_rows(out / "timing.csv", 3, process)
