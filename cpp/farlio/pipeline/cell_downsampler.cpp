@@ -1,9 +1,9 @@
 #include "farlio/pipeline/cell_downsampler.hpp"
 
-#include <tbb/parallel_sort.h>
-
 #include <algorithm>
+#include <array>
 #include <bit>
+#include <utility>
 
 #include "farlio/map/voxel_key.hpp"
 
@@ -13,6 +13,26 @@ namespace {
 constexpr std::size_t kMinSlots = std::size_t{1} << 10;
 /// Slots per expected cell (the previous scan's count): the table starts a quarter full.
 constexpr std::size_t kSlotsPerExpectedCell = 4;
+constexpr int kDigitBits = 8;
+constexpr std::size_t kDigitValues = std::size_t{1} << kDigitBits;
+constexpr int kKeyBits = 64;
+
+/// Sorts `cells` by key (least-significant-digit radix sort, 8 bits a pass; a pass whose digit is
+/// the same in every key is skipped: cells of one scan share the high bits of each coordinate).
+/// The keys are distinct, so the order equals std::sort's. `scratch` is kept between calls.
+void radix_sort_by_key(std::vector<std::pair<std::uint64_t, std::int32_t>>& cells,
+                       std::vector<std::pair<std::uint64_t, std::int32_t>>& scratch) {
+  scratch.resize(cells.size());
+  for (int shift = 0; shift < kKeyBits; shift += kDigitBits) {
+    std::array<std::size_t, kDigitValues> count{};
+    for (const auto& c : cells) ++count[(c.first >> shift) & (kDigitValues - 1)];
+    if (std::find(count.begin(), count.end(), cells.size()) != count.end()) continue;  // one digit value
+    std::size_t offset = 0;
+    for (std::size_t& n : count) offset += std::exchange(n, offset);
+    for (const auto& c : cells) scratch[count[(c.first >> shift) & (kDigitValues - 1)]++] = c;
+    cells.swap(scratch);
+  }
+}
 }  // namespace
 
 void CellTable::reset(std::size_t expected_cells) {
@@ -57,24 +77,10 @@ void CellTable::drain(std::vector<std::pair<std::uint64_t, std::int32_t>>& out) 
 
 const std::vector<std::int32_t>& CellDownsampler::first_of_each_cell(const std::uint64_t* keys, std::size_t n,
                                                                      exec::CpuExecutor& executor) {
-  const auto blocks = static_cast<std::size_t>(std::max(1, executor.num_threads()));
-  tables_.resize(blocks);
-  // 1. each block of the scan into its own table (a task per block, one thread each)
-  executor.for_each(
-      blocks,
-      [&](std::size_t b) {
-        CellTable& table = tables_[b];
-        table.reset(expected_cells_);
-        std::uint64_t previous = map::kEmptyKey;
-        for (std::size_t i = b * n / blocks; i < (b + 1) * n / blocks; ++i) {
-          const std::uint64_t key = keys[i];
-          // the previous point of the block had the same cell and a lower index: nothing to do
-          if (key == map::kEmptyKey || key == previous) continue;
-          previous = key;
-          table.insert_min(key, static_cast<std::int32_t>(i));
-        }
-      },
-      1);
+  return first_of_each_cell(n, executor, [keys](std::size_t i) { return keys[i]; });
+}
+
+const std::vector<std::int32_t>& CellDownsampler::merge_blocks(std::size_t blocks) {
   // 2. merge the blocks' tables into the first (lowest index per cell), then its cells in key order
   for (std::size_t b = 1; b < blocks; ++b) {
     cells_.clear();
@@ -83,7 +89,7 @@ const std::vector<std::int32_t>& CellDownsampler::first_of_each_cell(const std::
   }
   cells_.clear();
   tables_[0].drain(cells_);
-  executor.run([&] { tbb::parallel_sort(cells_.begin(), cells_.end()); });
+  radix_sort_by_key(cells_, scratch_);
   kept_.resize(cells_.size());
   for (std::size_t c = 0; c < cells_.size(); ++c) kept_[c] = cells_[c].second;
   expected_cells_ = cells_.size();

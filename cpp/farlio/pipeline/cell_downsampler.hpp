@@ -5,12 +5,15 @@
 // the other preprocessing (docs/performance.md). Each thread deduplicates a contiguous block of
 // the scan into its own table (no atomics, no cache line shared between cores), skipping a point
 // whose neighbour in the scan order fell into the same cell; the tables are then merged.
+#include <algorithm>
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <utility>
 #include <vector>
 
 #include "farlio/exec/cpu_executor.hpp"
+#include "farlio/map/voxel_key.hpp"
 
 namespace farlio::pipeline {
 
@@ -40,9 +43,46 @@ class CellDownsampler {
   const std::vector<std::int32_t>& first_of_each_cell(const std::uint64_t* keys, std::size_t n,
                                                       exec::CpuExecutor& executor);
 
+  /// The same with the keys computed in the blocks' loop: key_of(i) is the key of point i, called
+  /// once per point (the preprocessing's per-point body, which also writes the point).
+  template <typename KeyOf>
+  const std::vector<std::int32_t>& first_of_each_cell(std::size_t n, exec::CpuExecutor& executor,
+                                                      const KeyOf& key_of) {
+    const auto blocks = static_cast<std::size_t>(std::max(1, executor.num_threads()));
+    tables_.resize(blocks);
+    // each block of the scan into its own table (a task per block, one thread each)
+    executor.for_each(
+        blocks,
+        [&](std::size_t b) {
+          CellTable& table = tables_[b];
+          table.reset(expected_cells_);
+          // a key in `recent` is in the table with a lower index of this block: nothing to do
+          std::array<std::uint64_t, kRecentCells> recent;
+          recent.fill(map::kEmptyKey);
+          for (std::size_t i = b * n / blocks; i < (b + 1) * n / blocks; ++i) {
+            const std::uint64_t key = key_of(i);
+            if (key == map::kEmptyKey) continue;
+            std::uint64_t& slot = recent[map::packed_key_slot(key, kRecentCells - 1)];
+            if (slot == key) continue;
+            slot = key;
+            table.insert_min(key, static_cast<std::int32_t>(i));
+          }
+        },
+        1);
+    return merge_blocks(blocks);
+  }
+
  private:
+  /// Entries of a block's filter of recently inserted cells (direct-mapped, 4 KiB: stays in L1).
+  /// A scan visits a cell again within a few dozen points (the next column of a spinning LiDAR,
+  /// the next point of a ring), so most repeats are caught there instead of by a table probe.
+  static constexpr std::size_t kRecentCells = 512;
+
+  /// Merges the blocks' tables (lowest index per cell) and gives the cells' indices in key order.
+  const std::vector<std::int32_t>& merge_blocks(std::size_t blocks);
+
   std::vector<CellTable> tables_;  // one per block of the scan (a block per thread)
-  std::vector<std::pair<std::uint64_t, std::int32_t>> cells_;
+  std::vector<std::pair<std::uint64_t, std::int32_t>> cells_, scratch_;
   std::vector<std::int32_t> kept_;
   std::size_t expected_cells_ = 0;  // cells of the previous call: sizes the tables
 };

@@ -22,12 +22,11 @@ std::size_t CpuScanBackend::preprocess(const Scan& scan, const deskew::ScanMotio
                             1.0f / map_.spacing_m()};
   const std::size_t n = scan.size();
   points_.resize(n);  // buffers kept across scans: no allocation once grown
-  keys_.resize(n);
-  executor_.for_each(n, [&](std::size_t i) {
+  // one pass: each thread preprocesses its block of the scan and deduplicates its cells
+  const std::vector<std::int32_t>& kept = downsampler_.first_of_each_cell(n, executor_, [&](std::size_t i) {
     const float tau = undistort ? scan.time_s[i] : 0.0f;
-    keys_[i] = preprocess_point(scan.points[i], tau, pp, &points_[i]);
+    return preprocess_point(scan.points[i], tau, pp, &points_[i]);
   });
-  const std::vector<std::int32_t>& kept = downsampler_.first_of_each_cell(keys_.data(), n, executor_);
   frame_.resize(kept.size());
   for (std::size_t k = 0; k < kept.size(); ++k) frame_[k] = points_[static_cast<std::size_t>(kept[k])];
   return frame_.size();
