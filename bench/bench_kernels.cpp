@@ -17,6 +17,7 @@
 #include "farlio/pipeline/preprocess.hpp"
 #include "farlio/pipeline/range_crop.hpp"
 #include "farlio/pipeline/scan_pipeline.hpp"
+#include "farlio/pipeline/stage_limits.hpp"
 #include "farlio/registration/gicp.hpp"
 #include "farlio/sim/sequence_generator.hpp"
 
@@ -209,25 +210,15 @@ void BM_WholeFrame(benchmark::State& state) {
 
 // ---- the machine's limits, the yardsticks of docs/performance.md ----------------------------
 
-constexpr std::size_t kStreamBytes = std::size_t{256} << 20;  // far beyond the caches
 constexpr std::size_t kChaseBytes = std::size_t{64} << 20;
 constexpr std::size_t kL2TableBytes = std::size_t{512} << 10;  // a hash table that stays in L2
 
 /// Memory read bandwidth: a sum over a 256 MiB array (bytes_per_second).
 void BM_MemoryRead(benchmark::State& state) {
   exec::CpuExecutor ex(static_cast<int>(state.range(0)));
-  const std::vector<float> data(kStreamBytes / sizeof(float), 1.0f);
-  for (auto _ : state) {
-    benchmark::DoNotOptimize(ex.reduce(
-        data.size() / 1024, 0.0f,
-        [&](std::size_t b) {
-          float acc = 0.0f;
-          for (std::size_t i = b * 1024; i < (b + 1) * 1024; ++i) acc += data[i];
-          return acc;
-        },
-        [](float a, float b) { return a + b; }));
-  }
-  state.SetBytesProcessed(state.iterations() * static_cast<std::int64_t>(kStreamBytes));
+  const std::vector<float> data(pipeline::kYardstickStreamBytes / sizeof(float), 1.0f);
+  for (auto _ : state) benchmark::DoNotOptimize(pipeline::memory_read_kernel(data, ex));
+  state.SetBytesProcessed(state.iterations() * static_cast<std::int64_t>(pipeline::kYardstickStreamBytes));
 }
 
 /// A cache miss to memory: dependent loads along a random cycle over 64 MiB (time per load).
@@ -273,27 +264,13 @@ void BM_L2Probes(benchmark::State& state) {
 /// block_distances2), per thread count: the rate that bounds the neighbour searches.
 void BM_L1Distances(benchmark::State& state) {
   exec::CpuExecutor ex(static_cast<int>(state.range(0)));
-  constexpr std::int32_t kPoints = 320;  // 16 voxels' worth of a frame map: 5 KiB
-  constexpr std::size_t kQueries = 1 << 14;
-  std::vector<Eigen::Vector4f> points(kPoints);
-  for (std::int32_t i = 0; i < kPoints; ++i) points[static_cast<std::size_t>(i)] = Eigen::Vector4f::Random();
-  map::ConstMapView v;
-  v.points = points.data();
+  std::vector<Eigen::Vector4f> points(pipeline::kYardstickL1Points);
+  for (auto& p : points) p = Eigen::Vector4f::Random();
   for (auto _ : state) {
-    benchmark::DoNotOptimize(ex.reduce(
-        kQueries, 0.0f,
-        [&](std::size_t q) {
-          const Eigen::Vector3f p = Eigen::Vector3f::Constant(static_cast<float>(q) * 1e-4f);
-          float best = 1e30f, d2[map::kDistanceBlock];
-          for (std::int32_t j0 = 0; j0 < kPoints; j0 += map::kDistanceBlock) {
-            const std::int32_t len = map::block_distances2(v, j0, kPoints - j0, p, d2);
-            for (std::int32_t j = 0; j < len; ++j) best = std::min(best, d2[j]);
-          }
-          return best;
-        },
-        [](float a, float b) { return std::min(a, b); }));
+    benchmark::DoNotOptimize(pipeline::l1_distances_kernel(points, pipeline::kYardstickQueries, ex));
   }
-  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(kQueries) * kPoints);
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(pipeline::kYardstickQueries) *
+                          pipeline::kYardstickL1Points);
 }
 
 }  // namespace

@@ -1,7 +1,9 @@
 """Whole-frame benchmark: farlio's scan pipeline and KISS-ICP on the same scans, in the same
 process and run, one after the other per frame set. Reports per-frame latency (median, p99, max)
 and, when the scans have ground truth, the accuracy of both; for farlio also the time of each
-pipeline stage, the work per frame (iterations, points) and the memory (map, peak RSS)."""
+pipeline stage with the limit its work implies on this machine (pipeline/stage_limits.hpp:
+yardsticks measured in the same process), the work per frame (iterations, points) and the memory
+(map, peak RSS)."""
 
 from __future__ import annotations
 
@@ -20,6 +22,8 @@ from farlio import _core
 MS_PER_S = 1e3
 P99 = 99
 BYTES_PER_MIB = 2**20
+#: the yardsticks in GB/s and G distances/s
+GIGA = 1e9
 KIB_PER_MIB = 2**10
 #: getrusage's ru_maxrss counts KiB on Linux, bytes on macOS
 MAXRSS_UNITS_PER_MIB = BYTES_PER_MIB if sys.platform == "darwin" else KIB_PER_MIB
@@ -90,12 +94,18 @@ class FarlioRun:
     stage_ms: dict[str, list[float]] = field(default_factory=lambda: {s: [] for s in STAGES})
     work: dict[str, list[int]] = field(default_factory=lambda: {c: [] for c in WORK_COUNTS})
     trajectory: Any = field(default_factory=farlio.Trajectory)
+    #: per stage, the limit of each frame's work (ms) at the yardsticks' rates; empty without yardsticks
+    limit_ms: dict[str, list[float]] = field(default_factory=dict)
     #: map bytes, voxels, points after the last frame and the process's peak RSS (memory_report)
     memory: dict[str, float] = field(default_factory=dict)
 
-    def add(self, r: Any, ms: float) -> None:
-        """Frame result `r` of ScanPipeline.process, which took `ms` in all."""
+    def add(self, r: Any, ms: float, limits: Any = None) -> None:
+        """Frame result `r` of ScanPipeline.process, which took `ms` in all; `limits` its
+        StageLimits (None: not measured)."""
         self.frame_ms.append(ms)
+        if limits is not None:
+            for stage, attribute in STAGES.items():
+                self.limit_ms.setdefault(stage, []).append(getattr(limits, attribute) * MS_PER_S)
         for stage, attribute in STAGES.items():
             self.stage_ms[stage].append(getattr(r.timings, attribute) * MS_PER_S)
         for count in WORK_COUNTS:
@@ -118,16 +128,21 @@ def memory_report(pipe: Any, last: Any) -> dict[str, float]:
     }
 
 
-def run_farlio(scans: list[Any], config: Any) -> FarlioRun:
-    """Latency, stage times and work per frame, trajectory, device and memory of farlio's run."""
+def run_farlio(scans: list[Any], config: Any, yardsticks: Any = None) -> FarlioRun:
+    """Latency, stage times and work per frame, trajectory, device and memory of farlio's run;
+    with `yardsticks` (measure_yardsticks) also each frame's stage limits on the CPU."""
     pipe = _core.ScanPipeline(config)
     if pipe.device_message:
         print(f"farlio: {pipe.device_message}", file=sys.stderr)
     run = FarlioRun(pipe.device)
+    k = int(config.get("map.covariance_neighbors"))
+    if pipe.device != "cpu":
+        yardsticks = None  # the CPU's rates say nothing about a GPU's stages
     for s in scans:
         t0 = time.perf_counter()
         r = pipe.process(s)
-        run.add(r, (time.perf_counter() - t0) * MS_PER_S)
+        ms = (time.perf_counter() - t0) * MS_PER_S
+        run.add(r, ms, _core.stage_limits(r, k, yardsticks) if yardsticks is not None else None)
     run.memory = memory_report(pipe, r)
     return run
 
@@ -136,7 +151,17 @@ def _farlio_result(run: FarlioRun, gt: Any) -> dict[str, Any]:
     latency = _stats(run.frame_ms)
     stages = {s: _median_p99(ms) for s, ms in run.stage_ms.items()}
     stages[OTHER] = _median_p99(np.asarray(run.frame_ms) - run.stage_sums_ms())
+    limits = {}
+    if run.limit_ms:
+        # the median frame's limit per stage, and how many times it the measured median is
+        limits = {
+            s: {"limit_ms": float(np.median(v)), "ratio": stages[s]["median"] / float(np.median(v))}
+            for s, v in run.limit_ms.items()
+        }
+        total = float(np.median(np.sum(list(run.limit_ms.values()), axis=0)))
+        limits["whole_frame"] = {"limit_ms": total, "ratio": latency["median"] / total}
     return {
+        "stage_limits": limits,
         "latency_ms": latency,
         "p99_over_median": latency["p99"] / latency["median"],
         "stages_ms": stages,
@@ -178,6 +203,17 @@ def run_kiss(scans: list[Any], threads: int) -> tuple[list[float], Any]:
     return ms, traj
 
 
+_YARDSTICKS: dict[int, Any] = {}
+
+
+def yardsticks(threads: int) -> Any:
+    """The machine's rates on `threads` threads (measure_yardsticks, about 1 s), measured once per
+    thread count and process."""
+    if threads not in _YARDSTICKS:
+        _YARDSTICKS[threads] = _core.measure_yardsticks(threads)
+    return _YARDSTICKS[threads]
+
+
 def compare(
     scans: list[Any], gt: Any = None, *, threads: int = 0, with_kiss: bool = True, device: str = "auto"
 ) -> dict[str, Any]:
@@ -185,12 +221,17 @@ def compare(
     config = _core.Config()
     config.set("num_threads", str(threads))
     config.set("device", device)
-    run = run_farlio(scans, config)
+    sticks = yardsticks(threads)
+    run = run_farlio(scans, config, sticks)
     result: dict[str, Any] = {
         "frames": len(scans),
         "points_per_scan": float(np.mean([len(s) for s in scans])),
         "threads": threads,
         "device": run.device,
+        "yardsticks": {
+            "memory_read_gb_s": sticks.memory_read_bytes_per_s / GIGA,
+            "l1_distances_g_s": sticks.l1_distances_per_s / GIGA,
+        },
         "farlio": _farlio_result(run, gt),
     }
     if with_kiss:
@@ -234,22 +275,31 @@ def _system_table(name: str, r: dict[str, Any]) -> str:
     return "\n".join(rows)
 
 
-def _stage_row(label: str, ms: dict[str, float], note: str) -> str:
-    return f"{label:14s} {ms['median']:10.2f} {ms['p99']:10.2f}   {note}"
+def _stage_row(label: str, ms: dict[str, float], limit: dict[str, float] | None, note: str) -> str:
+    lim = f"{limit['limit_ms']:10.2f} {limit['ratio']:8.1f}x" if limit else f"{'':10s} {'':9s}"
+    return f"{label:14s} {ms['median']:10.2f} {ms['p99']:10.2f} {lim}   {note}"
 
 
 def _stage_table(r: dict[str, Any]) -> str:
-    """farlio's stages with their share of the median frame, the whole frame with its p99/median,
-    and KISS-ICP's whole frame with farlio's speed-up at the median and p99."""
+    """farlio's stages with their limit (the time their work takes at the yardsticks' rates) and
+    share of the median frame, the whole frame with its p99/median, and KISS-ICP's whole frame
+    with farlio's speed-up at the median and p99."""
     f = r["farlio"]
-    whole = f["latency_ms"]
-    rows = [f"{'stage':14s} {'median ms':>10s} {'p99 ms':>10s}   share"]
+    whole, limits = f["latency_ms"], f.get("stage_limits") or {}
+    rows = [f"{'stage':14s} {'median ms':>10s} {'p99 ms':>10s} {'limit ms':>10s} {'/ limit':>9s}   share"]
     for stage, ms in f["stages_ms"].items():
-        rows.append(_stage_row(stage.replace("_", " "), ms, f"{ms['median'] / whole['median'] * PERCENT:4.0f} %"))
-    rows.append(_stage_row("whole frame", whole, f"p99/median {f['p99_over_median']:.2f}"))
+        note = f"{ms['median'] / whole['median'] * PERCENT:4.0f} %"
+        rows.append(_stage_row(stage.replace("_", " "), ms, limits.get(stage), note))
+    rows.append(_stage_row("whole frame", whole, limits.get("whole_frame"), f"p99/median {f['p99_over_median']:.2f}"))
     if "speedup_median" in r:
         note = f"farlio {r['speedup_median']:.2f}x faster at the median, {r['speedup_p99']:.2f}x at p99"
-        rows.append(_stage_row("KISS-ICP frame", r["kiss_icp"]["latency_ms"], note))
+        rows.append(_stage_row("KISS-ICP frame", r["kiss_icp"]["latency_ms"], None, note))
+    if limits:
+        y = r["yardsticks"]
+        rows.append(
+            f"limit: the stage's unavoidable work at {y['memory_read_gb_s']:.1f} GB/s memory read and "
+            f"{y['l1_distances_g_s']:.2f} G distances/s in L1 (measured now; docs/performance.md)"
+        )
     return "\n".join(rows)
 
 

@@ -82,6 +82,23 @@ def test_work_and_memory_are_reported(two_thread_counts):
         assert text.count(heading) >= len(THREADS), heading
 
 
+def test_each_stage_has_its_limit_and_ratio(two_thread_counts):
+    results, text = two_thread_counts
+    for r in results.values():
+        sticks = r["yardsticks"]
+        assert sticks["memory_read_gb_s"] > 0 and sticks["l1_distances_g_s"] > 0, sticks
+        limits, stages = r["farlio"]["stage_limits"], r["farlio"]["stages_ms"]
+        assert set(limits) == {*STAGES, "whole_frame"}
+        for stage in STAGES:
+            assert limits[stage]["limit_ms"] > 0, (stage, limits[stage])
+            assert limits[stage]["ratio"] == pytest.approx(stages[stage]["median"] / limits[stage]["limit_ms"])
+        # the whole frame's limit is the median of the frames' sums: at least each stage's median limit
+        whole = limits["whole_frame"]
+        assert max(limits[s]["limit_ms"] for s in STAGES) <= whole["limit_ms"]
+        assert whole["ratio"] == pytest.approx(r["farlio"]["latency_ms"]["median"] / whole["limit_ms"])
+    assert text.count("/ limit") >= len(THREADS) and text.count("G distances/s") >= len(THREADS)
+
+
 def test_one_thread_count_keeps_the_plain_key(tmp_path):
     assert main(BENCH + ["--out", str(tmp_path)]) == 0
     results = json.loads((tmp_path / "bench.json").read_text())

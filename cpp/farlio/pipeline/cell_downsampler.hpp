@@ -46,8 +46,7 @@ class CellDownsampler {
   /// The same with the keys computed in the blocks' loop: key_of(i) is the key of point i, called
   /// once per point (the preprocessing's per-point body, which also writes the point).
   template <typename KeyOf>
-  const std::vector<std::int32_t>& first_of_each_cell(std::size_t n, exec::CpuExecutor& executor,
-                                                      const KeyOf& key_of) {
+  const std::vector<std::int32_t>& first_of_each_cell(std::size_t n, exec::CpuExecutor& executor, const KeyOf& key_of) {
     const auto blocks = static_cast<std::size_t>(std::max(1, executor.num_threads()));
     tables_.resize(blocks);
     // each block of the scan into its own table (a task per block, one thread each)
