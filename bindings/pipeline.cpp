@@ -228,6 +228,9 @@ void bind_pipeline(nb::module_& m) {
       .def_ro("undistorted", &pipeline::FrameResult::undistorted, "whether the scan was undistorted")
       .def_prop_ro("converged", [](const pipeline::FrameResult& r) { return r.registration.converged; })
       .def_prop_ro("iterations", [](const pipeline::FrameResult& r) { return r.registration.iterations; })
+      .def_prop_ro(
+          "coarse_iterations", [](const pipeline::FrameResult& r) { return r.registration.coarse_iterations; },
+          "of the iterations, those on every registration.coarse_stride-th source point")
       .def_prop_ro("inliers", [](const pipeline::FrameResult& r) { return r.registration.system.inliers; })
       .def_prop_ro("hessian", [](const pipeline::FrameResult& r) { return r.registration.system.H; })
       .def_prop_ro("gradient", [](const pipeline::FrameResult& r) { return r.registration.system.b; })
@@ -246,6 +249,8 @@ void bind_pipeline(nb::module_& m) {
   nb::class_<registration::RegistrationResult>(m, "RegistrationResult", "Pose with the Gauss-Newton system.")
       .def_ro("pose", &registration::RegistrationResult::pose)
       .def_ro("iterations", &registration::RegistrationResult::iterations)
+      .def_ro("coarse_iterations", &registration::RegistrationResult::coarse_iterations,
+              "of the iterations, those on every registration.coarse_stride-th source point")
       .def_ro("converged", &registration::RegistrationResult::converged)
       .def_ro("budget_exceeded", &registration::RegistrationResult::budget_exceeded)
       .def_ro("held_directions", &registration::RegistrationResult::held_directions,

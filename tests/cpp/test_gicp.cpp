@@ -105,6 +105,47 @@ TEST(Gicp, CorrespondenceReuseKeepsTheResultAndStaleMatchesWouldNot) {
   EXPECT_GT(trans_err(stale.pose, pb.truth), 2.0 * std::max(trans_err(reused.pose, pb.truth), 0.005));
 }
 
+TEST(Gicp, CoarseIterationsFromAFarGuessEndWhereAllPointsDo) {
+  Problem pb(make_pose(1.5, -0.7, 0.4, 20.0, 2.0));
+  const auto run = [&](const SE3& guess, int stride) {
+    RegistrationConfig cfg;
+    cfg.coarse_stride = stride;
+    return register_scan(pb.source, pb.target.view(), guess, Thresholds::from_sigma(1.0), cfg, kNoBudget, pb.ex);
+  };
+  Vec6d far_off;
+  far_off << 0.5, -0.4, 0.2, 0.02, -0.02, 0.08;
+  const SE3 far = pb.truth * SE3::exp(far_off);
+  const auto fine = run(far, 1), coarse = run(far, RegistrationConfig{}.coarse_stride);
+  ASSERT_TRUE(fine.converged && coarse.converged);
+  EXPECT_EQ(fine.coarse_iterations, 0);
+  EXPECT_GT(coarse.coarse_iterations, 0);                  // the first step is longer than coarse_step_norm
+  EXPECT_LT(coarse.coarse_iterations, coarse.iterations);  // the last iterations use every point
+  EXPECT_LT(trans_err(coarse.pose, pb.truth), 0.02);
+  EXPECT_LT(rot_err_deg(coarse.pose, pb.truth), 0.1);
+  EXPECT_LT(trans_err(coarse.pose, fine.pose), 0.005);
+  // the system returned is that of all points at the end, as without coarse iterations
+  EXPECT_NEAR(static_cast<double>(coarse.system.inliers), static_cast<double>(fine.system.inliers),
+              0.01 * static_cast<double>(fine.system.inliers));
+  EXPECT_GT(coarse.system.inliers, static_cast<long>(pb.source.size() * 8 / 10));
+
+  // a near guess: its first step is short, so no coarse iteration, and the very same result
+  Vec6d near_off;
+  near_off << 0.01, -0.01, 0.0, 0.0, 0.0, 0.002;
+  const SE3 near = pb.truth * SE3::exp(near_off);
+  const auto near_fine = run(near, 1), near_coarse = run(near, RegistrationConfig{}.coarse_stride);
+  EXPECT_EQ(near_coarse.coarse_iterations, 0);
+  EXPECT_EQ(near_coarse.iterations, near_fine.iterations);
+  EXPECT_EQ(near_coarse.pose.matrix(), near_fine.pose.matrix());
+}
+
+TEST(Gicp, StridedCountVisitsEveryStrideThPoint) {
+  EXPECT_EQ(strided_count(0, 4), 0u);
+  EXPECT_EQ(strided_count(1, 4), 1u);
+  EXPECT_EQ(strided_count(8, 4), 2u);
+  EXPECT_EQ(strided_count(9, 4), 3u);  // 0, 4, 8
+  EXPECT_EQ(strided_count(9, 1), 9u);
+}
+
 TEST(Gicp, PointToPointFallbackWithoutCovariance) {
   // A source point without a covariance is weighted by Omega = lambda I (Sigma_s = 0): the
   // paper's lambda = 1 here.

@@ -124,6 +124,12 @@ inline constexpr double kMaxThreads = 1024.0;
   FIELD(double, correspondence_reuse_m, 0.02, range::non_negative_up_to(kMaxSiValue),                             \
         "a source point keeps its map match over Gauss-Newton iterations until it has moved this far from where " \
         "the match was searched (0: a search every iteration, as the paper; the CUDA backend always searches)")   \
+  FIELD(int, coarse_stride, 4, range::between(1, kMaxCount),                                                      \
+        "after a Gauss-Newton step longer than coarse_step_norm (a far guess: the second scan, a restart), the "  \
+        "next iterations use every n-th source point until the steps are short again; the last iterations use "   \
+        "all (1: never coarse)")                                                                                  \
+  FIELD(double, coarse_step_norm, 0.1, range::positive_up_to(kMaxSiValue),                                        \
+        "|dx| (6-vector, m and rad) above which the next Gauss-Newton iteration is coarse (coarse_stride)")       \
   FIELD(double, time_budget_factor, 2.0, range::positive_up_to_or_inf(kMaxRatio),                                 \
         "time budget in LiDAR periods (paper: 2); a frame over it is dropped (inf: no budget)")                   \
   FIELD(double, damping, 1e-9, range::non_negative_up_to(kMaxRatio), "lambda added to the diagonal of H")         \

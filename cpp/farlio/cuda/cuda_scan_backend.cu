@@ -116,22 +116,27 @@ class CudaScanBackend final : public pipeline::ScanBackend {
   registration::RegistrationResult register_source(const SE3& initial_guess, const registration::Thresholds& th,
                                                    const RegistrationConfig& config, double time_budget_s) override {
     timer_.start(StageTimer::kRegistration);
-    const auto result = registration::gauss_newton([&](const SE3& T) { return linear_system(T, th, config); },
-                                                   initial_guess, config, time_budget_s);
+    const auto result = registration::gauss_newton(
+        [&](const SE3& T, std::size_t stride) { return linear_system(T, th, config, stride); }, initial_guess, config,
+        time_budget_s);
     timer_.stop(StageTimer::kRegistration);
     return result;
   }
 
-  /// One Gauss-Newton system: the shared factor body per source point, reduced with CUB.
+  /// One Gauss-Newton system: the shared factor body per source point (every stride-th), reduced
+  /// with CUB.
   registration::LinearSystem linear_system(const SE3& T, const registration::Thresholds& th,
-                                           const RegistrationConfig& config) {
+                                           const RegistrationConfig& config, std::size_t stride) {
     const registration::FactorParams fp = registration::factor_params(T, th, config);
     const map::ConstMapView target = map_.view();
     const Eigen::Vector4f* points = source_points_.data();
     const map::Cov3* covs = source_covs_.data();
     const registration::FactorSums sums = executor_.reduce(
-        source_size_, registration::FactorSums::zero(),
-        [=] __device__(std::size_t i) { return registration::factor_sums(target, points[i], covs[i], fp); },
+        registration::strided_count(source_size_, stride), registration::FactorSums::zero(),
+        [=] __device__(std::size_t j) {
+          const std::size_t i = j * stride;
+          return registration::factor_sums(target, points[i], covs[i], fp);
+        },
         registration::AddFactorSums{});
     return registration::to_linear_system(sums);
   }

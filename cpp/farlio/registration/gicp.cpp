@@ -50,17 +50,20 @@ LinearSystem build_linear_system(const SourceCloud& source, const map::ConstMapV
   return to_linear_system(sum);
 }
 
+std::size_t strided_count(std::size_t n, std::size_t stride) { return stride > 0 ? (n + stride - 1) / stride : n; }
+
 RegistrationResult register_scan(const SourceCloud& source, const map::ConstMapView& target, const SE3& initial_guess,
                                  const Thresholds& th, const RegistrationConfig& config, double time_budget_s,
                                  exec::CpuExecutor& executor) {
   // with correspondence_reuse_m = 0 every point is searched at every iteration
   std::vector<Correspondence> matches(source.size());
   const auto reuse2 = static_cast<float>(config.correspondence_reuse_m * config.correspondence_reuse_m);
-  const auto build = [&](const SE3& T) {
+  const auto build = [&](const SE3& T, std::size_t stride) {
     const FactorParams fp = factor_params(T, th, config);
     return to_linear_system(executor.reduce(
-        source.size(), FactorSums::zero(),
-        [&](std::size_t i) {
+        strided_count(source.size(), stride), FactorSums::zero(),
+        [&](std::size_t j) {
+          const std::size_t i = j * stride;
           return factor_sums_reusing(target, source.points[i], source.covs[i], fp, reuse2, matches[i]);
         },
         AddFactorSums{}));
@@ -91,9 +94,14 @@ RegistrationResult gauss_newton(const SystemBuilder& build, const SE3& initial_g
   auto elapsed_s = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
   RegistrationResult res;
   res.pose = initial_guess;
+  const auto coarse_stride = static_cast<std::size_t>(std::max(1, config.coarse_stride));
+  std::size_t stride = 1;  // the first iteration uses every point: a short step never goes coarse
+  std::size_t built_stride = 1;
   for (int it = 0; it < config.max_iterations; ++it) {
-    res.system = build(res.pose);
+    res.system = build(res.pose, stride);
+    built_stride = stride;
     res.iterations = it + 1;
+    if (stride > 1) ++res.coarse_iterations;
     if (res.system.inliers == 0) break;  // nothing to register against: not converged
     const Mat6d H = res.system.H + config.damping * Mat6d::Identity();
     Degeneracy degeneracy;  // none unless held
@@ -104,7 +112,7 @@ RegistrationResult gauss_newton(const SystemBuilder& build, const SE3& initial_g
     const Vec6d dx = step_without_degenerate_directions(H, res.system.b, degeneracy);
     if (!dx.allFinite()) break;
     res.pose = res.pose * SE3::exp(dx);
-    if (dx.norm() < config.convergence_norm) {
+    if (stride == 1 && dx.norm() < config.convergence_norm) {
       res.converged = true;
       break;
     }
@@ -112,7 +120,10 @@ RegistrationResult gauss_newton(const SystemBuilder& build, const SE3& initial_g
       res.budget_exceeded = true;
       break;
     }
+    stride = dx.norm() > config.coarse_step_norm ? coarse_stride : 1;
   }
+  // the result carries the system of all points (the fusion's information, the inlier count)
+  if (built_stride > 1 && !res.budget_exceeded) res.system = build(res.pose, 1);
   res.time_s = elapsed_s();
   return res;
 }

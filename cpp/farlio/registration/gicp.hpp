@@ -30,6 +30,7 @@ struct RegistrationResult {
   bool converged = false;        ///< |dx| fell below the convergence norm
   bool budget_exceeded = false;  ///< stopped by the time budget
   int held_directions = 0;       ///< degenerate directions held at the guess in the last step
+  int coarse_iterations = 0;     ///< of the iterations, those on every coarse_stride-th source point
   double time_s = 0.0;
 };
 
@@ -70,12 +71,19 @@ RegistrationResult register_scan(const SourceCloud& source, const map::ConstMapV
 std::string failure_reason(const RegistrationResult& result, std::size_t source_points,
                            const RegistrationConfig& config);
 
-/// Builds the linear system of the source at pose T (a backend's reduction).
-using SystemBuilder = std::function<LinearSystem(const SE3&)>;
+/// How many of n points the stride visits: 0, stride, 2 stride, ... < n.
+std::size_t strided_count(std::size_t n, std::size_t stride);
+
+/// Builds the linear system at pose T of the source points 0, stride, 2 stride, ... (a backend's
+/// reduction; stride 1: all of them).
+using SystemBuilder = std::function<LinearSystem(const SE3&, std::size_t stride)>;
 
 /// The Gauss-Newton loop on SE(3), whatever backend builds the systems: stops at convergence,
 /// without inliers, or when the time budget is spent. With hold_degenerate_directions, each step
 /// leaves the pose unchanged along the directions the system does not constrain (degeneracy.hpp).
+/// Coarse to fine: after a step longer than config.coarse_step_norm the next iteration uses every
+/// config.coarse_stride-th point; convergence is only declared on all points, and the result's
+/// system is always that of all points.
 RegistrationResult gauss_newton(const SystemBuilder& build, const SE3& initial_guess, const RegistrationConfig& config,
                                 double time_budget_s);
 
