@@ -218,8 +218,8 @@ def main() -> int:
             overrides, imu_source = VARIANTS[name]
             r = run_variant(seq, {**common, **overrides}, imu_source)
             print(
-                f"{seed:>4} {name:<14} {r['ape_m']:8.3f} {r['rot_deg']:8.3f} {r['rpe_pct']:7.3f} {r['rot_line_deg']:8.3f} "
-                f"{r['end_drift_m']:8.2f} {r['guess_rot_deg']:9.3f} {r['odom_rot_deg']:8.3f}",
+                f"{seed:>4} {name:<14} {r['ape_m']:8.3f} {r['rot_deg']:8.3f} {r['rpe_pct']:7.3f} "
+                f"{r['rot_line_deg']:8.3f} {r['end_drift_m']:8.2f} {r['guess_rot_deg']:9.3f} {r['odom_rot_deg']:8.3f}",
                 flush=True,
             )
     return 0
