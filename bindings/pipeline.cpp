@@ -188,17 +188,9 @@ void bind_pipeline(nb::module_& m) {
       "threads"_a = 0, "rounds"_a = 3, nb::call_guard<nb::gil_scoped_release>(),
       "memory read bandwidth and L1 distance rate on `threads` threads (0: all), the best of `rounds` "
       "(about 0.1 s each)");
-  nb::class_<pipeline::StageLimits>(m, "StageLimits",
-                                    "The time each stage's unavoidable work takes at the yardsticks' rates "
-                                    "(docs/performance.md).")
-      .def_ro("preprocess_s", &pipeline::StageLimits::preprocess_s)
-      .def_ro("covariance_s", &pipeline::StageLimits::covariance_s)
-      .def_ro("registration_s", &pipeline::StageLimits::registration_s)
-      .def_ro("map_update_s", &pipeline::StageLimits::map_update_s)
-      .def_prop_ro("total_s", &pipeline::StageLimits::total_s)
-      .def("__repr__", attribute_repr({"preprocess_s", "covariance_s", "registration_s", "map_update_s", "total_s"}));
   m.def("stage_limits", &pipeline::stage_limits, "frame"_a, "k"_a, "yardsticks"_a,
-        "the limits of one frame's stages; k is map.covariance_neighbors");
+        "the limits of one frame's stages as FrameTimings: the time each stage's unavoidable work takes at the "
+        "yardsticks' rates (docs/performance.md); k is map.covariance_neighbors");
 
   nb::class_<pipeline::FrameTimings>(m, "FrameTimings")
       .def_ro("preprocess_s", &pipeline::FrameTimings::preprocess_s)

@@ -101,7 +101,7 @@ class FarlioRun:
 
     def add(self, r: Any, ms: float, limits: Any = None) -> None:
         """Frame result `r` of ScanPipeline.process, which took `ms` in all; `limits` its
-        StageLimits (None: not measured)."""
+        stage limits (stage_limits, FrameTimings; None: not measured)."""
         self.frame_ms.append(ms)
         if limits is not None:
             for stage, attribute in STAGES.items():

@@ -43,15 +43,15 @@ TEST(StageLimits, FollowTheWorkModel) {
   f.map_insert.covariances_computed = 1000;
   const Yardsticks y{1, 1e10, 1e9};
   const int k = 10;
-  const StageLimits l = stage_limits(f, k, y);
+  const FrameTimings l = stage_limits(f, k, y);
   EXPECT_DOUBLE_EQ(l.preprocess_s, 28.0 * 100000 / 1e10);
   EXPECT_DOUBLE_EQ(l.covariance_s, 12.0 * 8000 / 1e10 + 4000.0 * k / 1e9 + 4000.0 * 220 / 8e9);
   EXPECT_DOUBLE_EQ(l.registration_s, 4000.0 / 1e9 + 3.0 * 4000 * 700 / 8e9);
   EXPECT_DOUBLE_EQ(l.map_update_s, (8000.0 + 1000.0 * k) / 1e9 + 1000.0 * 220 / 8e9);
-  EXPECT_DOUBLE_EQ(l.total_s(), l.preprocess_s + l.covariance_s + l.registration_s + l.map_update_s);
+  EXPECT_DOUBLE_EQ(l.total_s, l.preprocess_s + l.covariance_s + l.registration_s + l.map_update_s);
   // twice the rates: half the time; an unregistered frame has no registration work
-  const StageLimits fast = stage_limits(f, k, Yardsticks{1, 2e10, 2e9});
-  EXPECT_NEAR(fast.total_s(), 0.5 * l.total_s(), 1e-15);
+  const FrameTimings fast = stage_limits(f, k, Yardsticks{1, 2e10, 2e9});
+  EXPECT_NEAR(fast.total_s, 0.5 * l.total_s, 1e-15);
   f.registered = false;
   EXPECT_EQ(stage_limits(f, k, y).registration_s, 0.0);
 }
@@ -71,7 +71,7 @@ TEST(StageLimits, RealFramesHaveFiniteLimitsInEveryStage) {
   for (std::size_t i = 0; i < gen.num_scans(); ++i) {
     const FrameResult r = pipe.process(gen.scan(i));
     if (!r.registered) continue;
-    const StageLimits l = stage_limits(r, config.map.covariance_neighbors, y);
+    const FrameTimings l = stage_limits(r, config.map.covariance_neighbors, y);
     for (const double s : {l.preprocess_s, l.covariance_s, l.registration_s, l.map_update_s}) {
       EXPECT_TRUE(std::isfinite(s) && s > 0.0) << "scan " << i;
     }

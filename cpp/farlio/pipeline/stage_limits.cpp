@@ -85,11 +85,11 @@ Yardsticks measure_yardsticks(exec::CpuExecutor& executor, int rounds) {
   return y;
 }
 
-StageLimits stage_limits(const FrameResult& frame, int k, const Yardsticks& y) {
+FrameTimings stage_limits(const FrameResult& frame, int k, const Yardsticks& y) {
   const double bw = y.memory_read_bytes_per_s, dist = y.l1_distances_per_s, flops = kFlopsPerDistance * dist;
   const auto n = [](std::size_t v) { return static_cast<double>(v); };
   const double source = n(frame.source_points), kd = static_cast<double>(k);
-  StageLimits l;
+  FrameTimings l;
   l.preprocess_s = per_second(kPreprocessBytesPerPoint * n(frame.input_points), bw);
   l.covariance_s = per_second(kPointBytes * n(frame.kept_points), bw) + per_second(source * kd, dist) +
                    per_second(source * kCovarianceFlops, flops);
@@ -99,6 +99,7 @@ StageLimits stage_limits(const FrameResult& frame, int k, const Yardsticks& y) {
   const double covs = n(frame.map_insert.covariances_computed);
   l.map_update_s =
       per_second(n(frame.map_insert.candidates) + covs * kd, dist) + per_second(covs * kCovarianceFlops, flops);
+  l.total_s = l.preprocess_s + l.covariance_s + l.registration_s + l.map_update_s;
   return l;
 }
 

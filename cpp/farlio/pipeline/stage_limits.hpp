@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "farlio/exec/cpu_executor.hpp"
+#include "farlio/pipeline/frame_timings.hpp"
 #include "farlio/pipeline/scan_pipeline.hpp"
 
 namespace farlio::pipeline {
@@ -57,13 +58,9 @@ inline constexpr double kPreprocessBytesPerPoint = 28.0;
 /// Bytes of a kept point (xyz).
 inline constexpr double kPointBytes = 12.0;
 
-/// The time, in seconds, each stage's unavoidable work takes at the yardsticks' rates.
-struct StageLimits {
-  double preprocess_s = 0.0, covariance_s = 0.0, registration_s = 0.0, map_update_s = 0.0;
-  [[nodiscard]] double total_s() const { return preprocess_s + covariance_s + registration_s + map_update_s; }
-};
-
-/// The limits of one frame's stages; `k` is map.covariance_neighbors.
-StageLimits stage_limits(const FrameResult& frame, int k, const Yardsticks& y);
+/// The limits of one frame's stages: the time, in seconds, each stage's unavoidable work takes at
+/// the yardsticks' rates, in the shape of the frame's own timings (total_s: their sum); `k` is
+/// map.covariance_neighbors.
+FrameTimings stage_limits(const FrameResult& frame, int k, const Yardsticks& y);
 
 }  // namespace farlio::pipeline

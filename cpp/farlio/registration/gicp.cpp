@@ -112,7 +112,8 @@ RegistrationResult gauss_newton(const SystemBuilder& build, const SE3& initial_g
     const Vec6d dx = step_without_degenerate_directions(H, res.system.b, degeneracy);
     if (!dx.allFinite()) break;
     res.pose = res.pose * SE3::exp(dx);
-    if (stride == 1 && dx.norm() < config.convergence_norm) {
+    const double step = dx.norm();
+    if (stride == 1 && step < config.convergence_norm) {
       res.converged = true;
       break;
     }
@@ -120,7 +121,7 @@ RegistrationResult gauss_newton(const SystemBuilder& build, const SE3& initial_g
       res.budget_exceeded = true;
       break;
     }
-    stride = dx.norm() > config.coarse_step_norm ? coarse_stride : 1;
+    stride = step > config.coarse_step_norm ? coarse_stride : 1;
   }
   // the result carries the system of all points (the fusion's information, the inlier count)
   if (built_stride > 1 && !res.budget_exceeded) res.system = build(res.pose, 1);
