@@ -96,6 +96,8 @@ class FarlioRun:
     trajectory: Any = field(default_factory=farlio.Trajectory)
     #: per stage, the limit of each frame's work (ms) at the yardsticks' rates; empty without yardsticks
     limit_ms: dict[str, list[float]] = field(default_factory=dict)
+    #: the machine's rates the limits were computed at (measure_yardsticks); None without limits
+    yardsticks: Any = None
     #: map bytes, voxels, points after the last frame and the process's peak RSS (memory_report)
     memory: dict[str, float] = field(default_factory=dict)
 
@@ -128,21 +130,22 @@ def memory_report(pipe: Any, last: Any) -> dict[str, float]:
     }
 
 
-def run_farlio(scans: list[Any], config: Any, yardsticks: Any = None) -> FarlioRun:
+def run_farlio(scans: list[Any], config: Any, limits: bool = False) -> FarlioRun:
     """Latency, stage times and work per frame, trajectory, device and memory of farlio's run;
-    with `yardsticks` (measure_yardsticks) also each frame's stage limits on the CPU."""
+    with `limits`, on the CPU, also each frame's stage limits at the machine's yardsticks (the
+    CPU's rates say nothing about a GPU's stages: none there)."""
     pipe = _core.ScanPipeline(config)
     if pipe.device_message:
         print(f"farlio: {pipe.device_message}", file=sys.stderr)
     run = FarlioRun(pipe.device)
+    if limits and pipe.device == "cpu":
+        run.yardsticks = yardsticks(int(config.get("num_threads")))
     k = int(config.get("map.covariance_neighbors"))
-    if pipe.device != "cpu":
-        yardsticks = None  # the CPU's rates say nothing about a GPU's stages
     for s in scans:
         t0 = time.perf_counter()
         r = pipe.process(s)
         ms = (time.perf_counter() - t0) * MS_PER_S
-        run.add(r, ms, _core.stage_limits(r, k, yardsticks) if yardsticks is not None else None)
+        run.add(r, ms, _core.stage_limits(r, k, run.yardsticks) if run.yardsticks is not None else None)
     run.memory = memory_report(pipe, r)
     return run
 
@@ -221,14 +224,16 @@ def compare(
     config = _core.Config()
     config.set("num_threads", str(threads))
     config.set("device", device)
-    sticks = yardsticks(threads)
-    run = run_farlio(scans, config, sticks)
+    run = run_farlio(scans, config, limits=True)
+    sticks = run.yardsticks
     result: dict[str, Any] = {
         "frames": len(scans),
         "points_per_scan": float(np.mean([len(s) for s in scans])),
         "threads": threads,
         "device": run.device,
-        "yardsticks": {
+        "yardsticks": None
+        if sticks is None
+        else {
             "memory_read_gb_s": sticks.memory_read_bytes_per_s / GIGA,
             "l1_distances_g_s": sticks.l1_distances_per_s / GIGA,
         },
