@@ -18,13 +18,14 @@ Each variant isolates one part of the fusion:
   no_bias         fusion.standstill_bias=false
   fixed_noise     the LiDAR measurement from the fixed fusion.lidar_*_std values instead of the
                   registration's information matrix
-Columns: APE (m), rotation RMSE (deg) and KITTI-style RPE (%) of the scan poses (body frame); the
-rotation RMSE again with the rotation about the trajectory's principal axis taken from the
-orientations ("rot|line": a 30 s urban drive is a near-line, 270 x 21 x 6 m, whose positions fix that
-rotation only to about their residual over the lateral spread, 0.3 deg; docs/fusion.md); the end
-drift with the first pose aligned (m), the median rotation error of the initial guess the fusion
-gave the registration (deg; "-" without fusion) and the rotation RMSE of the 100 Hz fused odometry
-(deg).
+First, per seed, the spreads of the ground-truth positions along their principal axes (m). Columns:
+APE (m), rotation RMSE (deg) and KITTI-style RPE (%) of the scan poses (body frame); the rotation
+RMSE again with the rotation about the trajectory's principal axis taken from the orientations
+("rot|line": a 30 s urban drive is a near-line whose positions fix that rotation only to about their
+residual over the lateral spread; docs/fusion.md); "align", the angle of the evaluation's alignment
+(deg: how far the run's frame is from the ground truth's, as the alignment found it); the end drift
+with the first pose aligned (m), the median rotation error of the initial guess the fusion gave the
+registration (deg; "-" without fusion) and the rotation RMSE of the 100 Hz fused odometry (deg).
 
   python scripts/diagnose_fusion.py --profile racetrack --duration 30 --seeds 1 2 \
       [--variants lio lidar_only ...] [--set name=value ...]
@@ -153,6 +154,7 @@ def run_variant(seq: Sequence, overrides: dict[str, str], imu_source: str) -> di
         "ape_m": r.ape.translation_m.rmse,
         "rot_deg": r.ape.rotation_deg.rmse,
         "rot_line_deg": r_line.ape.rotation_deg.rmse,
+        "align_deg": math.degrees(r.ape.alignment.transform.angle_rad()),
         "rpe_pct": r.kitti_rpe.translation_pct,
         "end_drift_m": float(end_drift),
         "guess_rot_deg": statistics.median(guess_errors) if guess_errors else math.nan,
@@ -161,6 +163,14 @@ def run_variant(seq: Sequence, overrides: dict[str, str], imu_source: str) -> di
     if len(odometry) > 1:
         row["odom_rot_deg"] = _core.eval.evaluate(odometry, seq.gt_body, options).ape.rotation_deg.rmse
     return row
+
+
+def position_spreads_m(trajectory) -> np.ndarray:
+    """The spreads of a trajectory's positions along their principal axes (m, largest first: the
+    RMS distance from the centroid along each axis), which fix the alignment's rotations about the
+    other axes."""
+    p = np.array([pose.translation for pose in poses(trajectory)])
+    return np.linalg.svd(p - p.mean(axis=0), compute_uv=False) / math.sqrt(len(p))
 
 
 def covariance_scale(seq: Sequence) -> tuple[float, float]:
@@ -209,17 +219,20 @@ def main() -> int:
             print(f"{args.profile} seed {seed}: covariance_scale mean {mean:.2e}, median {median:.2e}")
         return 0
     print(
-        f"{'seed':>4} {'variant':<14} {'APE m':>8} {'rot deg':>8} {'RPE %':>7} {'rot|line':>8} {'drift m':>8} "
-        f"{'guess deg':>9} {'odom deg':>8}"
+        f"{'seed':>4} {'variant':<14} {'APE m':>8} {'rot deg':>8} {'RPE %':>7} {'rot|line':>8} {'align':>6} "
+        f"{'drift m':>8} {'guess deg':>9} {'odom deg':>8}"
     )
     for seed in args.seeds:
         seq = Sequence(args.profile, seed, args.duration, args.cache)
+        spread = position_spreads_m(seq.gt_scans)
+        print(f"{seed:>4} ground-truth positions spread {spread[0]:.2f} / {spread[1]:.2f} / {spread[2]:.2f} m")
         for name in args.variants:
             overrides, imu_source = VARIANTS[name]
             r = run_variant(seq, {**common, **overrides}, imu_source)
             print(
                 f"{seed:>4} {name:<14} {r['ape_m']:8.3f} {r['rot_deg']:8.3f} {r['rpe_pct']:7.3f} "
-                f"{r['rot_line_deg']:8.3f} {r['end_drift_m']:8.2f} {r['guess_rot_deg']:9.3f} {r['odom_rot_deg']:8.3f}",
+                f"{r['rot_line_deg']:8.3f} {r['align_deg']:6.3f} {r['end_drift_m']:8.2f} {r['guess_rot_deg']:9.3f} "
+                f"{r['odom_rot_deg']:8.3f}",
                 flush=True,
             )
     return 0
