@@ -14,6 +14,7 @@
 #include "farlio/map/voxel_map.hpp"
 #include "farlio/map/voxel_update.hpp"
 #include "farlio/pipeline/cell_downsampler.hpp"
+#include "farlio/pipeline/cpu_scan_backend.hpp"
 #include "farlio/pipeline/preprocess.hpp"
 #include "farlio/pipeline/range_crop.hpp"
 #include "farlio/pipeline/scan_pipeline.hpp"
@@ -52,21 +53,19 @@ std::vector<Eigen::Vector3f> downsampled(const Scan& scan, exec::CpuExecutor& ex
   return out;
 }
 
-/// The preprocessing as the pipeline runs it: crop and cell key per point, then the first point
-/// of each cell (the downsampler's table reused from scan to scan).
-void BM_Downsample(benchmark::State& state) {
-  exec::CpuExecutor ex(static_cast<int>(state.range(0)));
+/// The preprocessing as the pipeline runs it (CpuScanBackend::preprocess): crop and cell key per
+/// point, the first point of each cell, and (second argument 1) the undistortion of the kept
+/// points with a constant twist of urban speed. The backend's buffers are reused from scan to scan.
+void BM_Preprocess(benchmark::State& state) {
+  Config cfg;
+  cfg.num_threads = static_cast<int>(state.range(0));
+  const bool undistort = state.range(1) != 0;
+  pipeline::CpuScanBackend backend(cfg);
   const Scan& scan = urban_scans().front();
-  const pipeline::RangeCrop crop = pipeline::RangeCrop::from(PreprocessConfig{});
-  const float inv_cell = 1.0f / static_cast<float>(map::point_spacing_m(VoxelMapConfig{}));
-  std::vector<std::uint64_t> keys(scan.size());
-  pipeline::CellDownsampler downsampler;
-  for (auto _ : state) {
-    ex.for_each(scan.size(), [&](std::size_t i) {
-      keys[i] = crop.keeps(scan.points[i]) ? map::point_key(scan.points[i], inv_cell) : map::kEmptyKey;
-    });
-    benchmark::DoNotOptimize(downsampler.first_of_each_cell(keys.data(), keys.size(), ex).data());
-  }
+  deskew::Vec6f twist;
+  twist << 10.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.3f;  // m/s and rad/s
+  const auto motion = deskew::ScanMotion::constant_twist(twist, static_cast<float>(scan.duration_s()));
+  for (auto _ : state) benchmark::DoNotOptimize(backend.preprocess(scan, motion, undistort));
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(scan.size()));
 }
 
@@ -279,7 +278,7 @@ BENCHMARK(BM_L1Distances)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRea
 BENCHMARK(BM_MemoryRead)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_MemoryLatency)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_L2Probes)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_Downsample)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Preprocess)->ArgsProduct({{1, 2}, {0, 1}})->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_MapInsert)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_NearestNeighbor)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_CovarianceKnn)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "farlio/exec/cpu_executor.hpp"
+#include "farlio/exec/hd_math.hpp"
 #include "farlio/map/neighbor_search.hpp"
 #include "farlio/map/voxel_map.hpp"
 #include "farlio/map/voxel_update.hpp"
@@ -24,6 +25,28 @@ TEST(SharedBodies, PointKeyDropsNonFiniteAndOutOfRangePoints) {
   EXPECT_EQ(map::point_key({nan, 0, 0}, 1.0f), map::kEmptyKey);
   EXPECT_EQ(map::point_key({1e12f, 0, 0}, 1.0f), map::kEmptyKey);
   EXPECT_EQ(map::point_key({1.5f, -0.5f, 2.0f}, 1.0f), map::pack_key(map::VoxelCoord(1, -1, 2)));
+}
+
+TEST(SharedBodies, FloorToIntEqualsFloorfOverTheIntRange) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> wide(-2.1e9f, 2.1e9f), narrow(-300.0f, 300.0f);
+  std::vector<float> xs = {0.0f,
+                           -0.0f,
+                           0.5f,
+                           -0.5f,
+                           1.0f,
+                           -1.0f,
+                           -1e-30f,
+                           1e-30f,
+                           16777216.0f,
+                           -16777216.0f,
+                           -2147483648.0f,
+                           2147483520.0f,
+                           std::nextafter(-1.0f, 0.0f),
+                           std::nextafter(-1.0f, -2.0f),
+                           std::nextafter(0.0f, -1.0f)};
+  for (int i = 0; i < 100000; ++i) xs.push_back(i % 2 ? wide(rng) : narrow(rng));
+  for (const float x : xs) ASSERT_EQ(exec::floor_to_int(x), static_cast<int>(std::floor(x))) << x;
 }
 
 TEST(SharedBodies, RangeCropKeepsTheClosedInterval) {

@@ -147,6 +147,48 @@ TEST(VoxelMap, NearestAndKnnEqualBruteForce) {
   }
 }
 
+// Points on a lattice have many exactly equal distances: the k nearest are the first k of the
+// candidates in the search's visit order (the 27 voxels centre first, each voxel's points in pool
+// order) stably sorted by distance, with and without a distance limit.
+TEST(VoxelMap, KnnBreaksDistanceTiesByVisitOrder) {
+  exec::CpuExecutor ex(1);
+  auto cfg = small_config();
+  cfg.point_spacing_m = 0.0;
+  VoxelMap m(cfg, ex);
+  std::vector<Eigen::Vector3f> lattice;
+  constexpr int kSteps = 12;  // 0.25 m apart over 3 m: 2.5 voxels a side
+  constexpr float kStep_m = 0.25f;
+  for (int x = 0; x < kSteps; ++x)
+    for (int y = 0; y < kSteps; ++y)
+      for (int z = 0; z < 2; ++z) lattice.emplace_back(kStep_m * x + 0.01f, kStep_m * y + 0.01f, kStep_m * z + 0.01f);
+  m.insert(lattice, Eigen::Vector3f::Zero(), PointLimit::constant(20));
+  const MapView v = m.view();
+  for (const float limit_m : {100.0f, 0.3f}) {
+    for (const auto& q : lattice) {
+      std::vector<std::pair<float, std::int64_t>> visit;  // (d2, pool index) in visit order
+      for (int n = 0; n < kNeighborVoxels; ++n) {
+        const std::int32_t vox = table_find(v, neighbor_voxel(voxel_of(q, v.inv_voxel_size), n));
+        if (vox < 0) continue;
+        for (std::int32_t j = 0; j < v.voxel_counts[vox]; ++j) {
+          const std::int64_t i = v.point_index(vox, j);
+          const float d2 = (v.points[i].head<3>() - q).squaredNorm();
+          if (d2 < limit_m * limit_m) visit.emplace_back(d2, i);
+        }
+      }
+      std::stable_sort(visit.begin(), visit.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+      const int k = 10;
+      std::int64_t idx[kMaxNeighbors];
+      float kd[kMaxNeighbors];
+      const int found = knn_search(v, q, k, limit_m * limit_m, idx, kd);
+      ASSERT_EQ(found, std::min<int>(k, static_cast<int>(visit.size())));
+      for (int i = 0; i < found; ++i) {
+        EXPECT_EQ(idx[i], visit[static_cast<std::size_t>(i)].second) << "rank " << i;
+        EXPECT_EQ(kd[i], visit[static_cast<std::size_t>(i)].first);
+      }
+    }
+  }
+}
+
 TEST(VoxelMap, ForcedCollisionsInASmallTable) {
   exec::CpuExecutor ex(2);
   auto cfg = small_config();

@@ -49,7 +49,6 @@ class CudaScanBackend final : public pipeline::ScanBackend {
                    kFrameMapParameter, executor_, algorithms_, scratch_),
         raw_(max_points_, "scan points"),
         times_(max_points_, "scan points"),
-        deskewed_(max_points_, "scan points"),
         frame_(max_points_, "scan points"),
         world_(max_points_, "scan points"),
         source_points_(max_points_, "source points"),
@@ -79,24 +78,24 @@ class CudaScanBackend final : public pipeline::ScanBackend {
     return frame_size_;
   }
 
-  /// Crop, undistortion and the keys of the downsampling cells (one thread a point), then the
-  /// first point of each cell in (cell key, input order), as CpuScanBackend::preprocess.
+  /// Crop and the keys of the downsampling cells (one thread a point), then the first point of
+  /// each cell in (cell key, input order), undistorted, as CpuScanBackend::preprocess.
   std::size_t downsample(std::size_t n, const deskew::DeskewTable& motion, bool undistort) {
     const pipeline::PreprocessParams pp{pipeline::RangeCrop::from(config_.preprocess), motion, undistort,
                                         1.0f / map_.spacing_m()};
     const Eigen::Vector3f* raw = raw_.data();
     const float* times = times_.data();
-    Eigen::Vector3f* deskewed = deskewed_.data();
     std::uint64_t* keys = scratch_.keys.data();
-    executor_.for_each(n, [=] __device__(std::size_t i) {
-      keys[i] = pipeline::preprocess_point(raw[i], undistort ? times[i] : 0.0f, pp, &deskewed[i]);
-    });
+    executor_.for_each(n, [=] __device__(std::size_t i) { keys[i] = pipeline::downsampling_key(raw[i], pp); });
     std::size_t valid = 0;
     const std::size_t kept = sort_into_groups(scratch_, executor_, algorithms_, n, &valid);
     const std::int32_t* starts = scratch_.group_start.data();
     const std::int32_t* order = scratch_.sorted_order.data();
     Eigen::Vector3f* frame = frame_.data();
-    executor_.for_each(kept, [=] __device__(std::size_t g) { frame[g] = deskewed[order[starts[g]]]; });
+    executor_.for_each(kept, [=] __device__(std::size_t g) {
+      const std::int32_t i = order[starts[g]];
+      frame[g] = pipeline::undistorted_point(raw[i], undistort ? times[i] : 0.0f, pp);
+    });
     return kept;
   }
 
@@ -175,8 +174,8 @@ class CudaScanBackend final : public pipeline::ScanBackend {
 
   [[nodiscard]] std::size_t memory_bytes() const override {
     return executor_.memory_bytes() + algorithms_.memory_bytes() + scratch_.memory_bytes() + map_.memory_bytes() +
-           frame_map_.memory_bytes() + raw_.bytes() + times_.bytes() + deskewed_.bytes() + frame_.bytes() +
-           world_.bytes() + source_points_.bytes() + source_covs_.bytes();
+           frame_map_.memory_bytes() + raw_.bytes() + times_.bytes() + frame_.bytes() + world_.bytes() +
+           source_points_.bytes() + source_covs_.bytes();
   }
 
   bool device_stage_times(pipeline::FrameTimings& t) override {
@@ -209,7 +208,6 @@ class CudaScanBackend final : public pipeline::ScanBackend {
   DeviceVoxelMap frame_map_;
   DeviceBuffer<Eigen::Vector3f> raw_;
   DeviceBuffer<float> times_;
-  DeviceBuffer<Eigen::Vector3f> deskewed_;
   DeviceBuffer<Eigen::Vector3f> frame_;  // the kept points (sensor frame, scan end)
   DeviceBuffer<Eigen::Vector3f> world_;
   DeviceBuffer<Eigen::Vector4f> source_points_;

@@ -7,6 +7,7 @@
 #include <cstdint>
 
 #include "farlio/exec/hd.hpp"
+#include "farlio/exec/hd_math.hpp"
 
 namespace farlio::map {
 
@@ -21,8 +22,8 @@ inline constexpr std::uint64_t kErasedKey = ~std::uint64_t{0} - 1;
 using VoxelCoord = Eigen::Vector3i;
 
 FARLIO_HD inline VoxelCoord voxel_of(const Eigen::Vector3f& p, float inv_voxel_size) {
-  return {static_cast<int>(floorf(p.x() * inv_voxel_size)), static_cast<int>(floorf(p.y() * inv_voxel_size)),
-          static_cast<int>(floorf(p.z() * inv_voxel_size))};
+  return {exec::floor_to_int(p.x() * inv_voxel_size), exec::floor_to_int(p.y() * inv_voxel_size),
+          exec::floor_to_int(p.z() * inv_voxel_size)};
 }
 
 FARLIO_HD inline std::uint64_t pack_key(const VoxelCoord& c) {

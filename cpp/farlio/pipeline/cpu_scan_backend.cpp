@@ -20,15 +20,15 @@ std::size_t CpuScanBackend::preprocess(const Scan& scan, const deskew::ScanMotio
   const PreprocessParams pp{RangeCrop::from(config_.preprocess),
                             deskew::DeskewTable::sample(motion, static_cast<float>(scan.duration_s())), undistort,
                             1.0f / map_.spacing_m()};
-  const std::size_t n = scan.size();
-  points_.resize(n);  // buffers kept across scans: no allocation once grown
-  // one pass: each thread preprocesses its block of the scan and deduplicates its cells
-  const std::vector<std::int32_t>& kept = downsampler_.first_of_each_cell(n, executor_, [&](std::size_t i) {
-    const float tau = undistort ? scan.time_s[i] : 0.0f;
-    return preprocess_point(scan.points[i], tau, pp, &points_[i]);
-  });
+  // one pass: each thread crops its block of the scan and deduplicates its cells
+  const std::vector<std::int32_t>& kept = downsampler_.first_of_each_cell(
+      scan.size(), executor_, [&](std::size_t i) { return downsampling_key(scan.points[i], pp); });
+  // then only the kept points are undistorted
   frame_.resize(kept.size());
-  for (std::size_t k = 0; k < kept.size(); ++k) frame_[k] = points_[static_cast<std::size_t>(kept[k])];
+  executor_.for_each(kept.size(), [&](std::size_t k) {
+    const auto i = static_cast<std::size_t>(kept[k]);
+    frame_[k] = undistorted_point(scan.points[i], undistort ? scan.time_s[i] : 0.0f, pp);
+  });
   return frame_.size();
 }
 

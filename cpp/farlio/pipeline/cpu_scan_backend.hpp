@@ -35,8 +35,7 @@ class CpuScanBackend final : public ScanBackend {
   map::VoxelMap map_;
   map::VoxelMap frame_map_;
   CellDownsampler downsampler_;
-  std::vector<Eigen::Vector3f> points_;  // preprocessed points of the scan (valid where kept)
-  std::vector<Eigen::Vector3f> frame_;   // the kept points (sensor frame, scan end)
+  std::vector<Eigen::Vector3f> frame_;  // the kept points (sensor frame, scan end)
   registration::SourceCloud source_;
 };
 

@@ -72,7 +72,7 @@ std::size_t MapExport::add(const Scan& scan, const deskew::ScanMotion& motion, b
   const Eigen::Vector3d sensor = pose.translation();
   if (!spill_dir_.empty()) reload_near(sensor);
   const bool deskew = undistort && scan.has_time();
-  // the cell size is not used here: only the crop and the undistortion of preprocess_point
+  // the cell size is not used here: only the crop and undistorted_point
   const PreprocessParams pp{RangeCrop::from(preprocess_),
                             deskew::DeskewTable::sample(motion, static_cast<float>(scan.duration_s())), deskew, 1.0f};
   const Eigen::Matrix3d R = pose.rotation();
@@ -83,9 +83,9 @@ std::size_t MapExport::add(const Scan& scan, const deskew::ScanMotion& motion, b
   offsets_.resize(n);
   // per point, in parallel: crop, undistortion, world position, its cell and the offset in it
   executor_.for_each(n, [&](std::size_t i) {
-    Eigen::Vector3f p;
     keys_[i] = map::kEmptyKey;
-    if (preprocess_point(scan.points[i], deskew ? scan.time_s[i] : 0.0f, pp, &p) == map::kEmptyKey) return;
+    if (!pp.crop.keeps(scan.points[i])) return;
+    const Eigen::Vector3f p = undistorted_point(scan.points[i], deskew ? scan.time_s[i] : 0.0f, pp);
     const Eigen::Vector3d w = R * p.cast<double>() + sensor;
     const std::uint64_t key = map::point_key(w.cast<float>(), inv_cell);
     if (key == map::kEmptyKey) return;

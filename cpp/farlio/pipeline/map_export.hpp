@@ -13,7 +13,7 @@
 // the run's length; the files are removed with the MapExport. for_each_piece streams the whole
 // map, tile by tile, to a writer.
 //
-// The points go through the preprocessing's per-point body (preprocess_point.hpp: range crop and
+// The points go through the preprocessing's per-point bodies (preprocess_point.hpp: range crop and
 // undistortion with the motion the pipeline used), so the map holds what the registration saw.
 #include <Eigen/Core>
 #include <cstddef>
