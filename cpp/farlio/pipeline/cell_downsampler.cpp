@@ -17,9 +17,9 @@ constexpr int kDigitBits = 8;
 constexpr std::size_t kDigitValues = std::size_t{1} << kDigitBits;
 constexpr int kKeyBits = 64;
 
-/// Sorts `cells` by key (least-significant-digit radix sort, 8 bits a pass; a pass whose digit is
-/// the same in every key is skipped: cells of one scan share the high bits of each coordinate).
-/// The keys are distinct, so the order equals std::sort's. `scratch` is kept between calls.
+/// Sorts `cells` by key, stably (least-significant-digit radix sort, 8 bits a pass; a pass whose
+/// digit is the same in every key is skipped: cells of one scan share the high bits of each
+/// coordinate). The order equals std::stable_sort's. `scratch` is kept between calls.
 void radix_sort_by_key(std::vector<std::pair<std::uint64_t, std::int32_t>>& cells,
                        std::vector<std::pair<std::uint64_t, std::int32_t>>& scratch) {
   scratch.resize(cells.size());
@@ -40,8 +40,10 @@ void CellTable::reset(std::size_t expected_cells) {
   if (keys_.size() != slots) {
     keys_.assign(slots, map::kEmptyKey);
     first_.assign(slots, 0);
+    used_.clear();
   }
-  cells_ = 0;
+  for (const std::uint32_t s : used_) keys_[s] = map::kEmptyKey;  // a table not drained since
+  used_.clear();
 }
 
 void CellTable::insert_min(std::uint64_t key, std::int32_t index) {
@@ -54,12 +56,13 @@ void CellTable::insert_min(std::uint64_t key, std::int32_t index) {
   }
   keys_[s] = key;
   first_[s] = index;
-  if (2 * ++cells_ > keys_.size()) grow();
+  used_.push_back(static_cast<std::uint32_t>(s));
+  if (2 * used_.size() > keys_.size()) grow();
 }
 
 void CellTable::grow() {
   std::vector<std::pair<std::uint64_t, std::int32_t>> held;
-  held.reserve(cells_);
+  held.reserve(used_.size());
   drain(held);
   keys_.assign(2 * keys_.size(), map::kEmptyKey);
   first_.assign(keys_.size(), 0);
@@ -67,12 +70,12 @@ void CellTable::grow() {
 }
 
 void CellTable::drain(std::vector<std::pair<std::uint64_t, std::int32_t>>& out) {
-  for (std::size_t s = 0; s < keys_.size(); ++s) {
-    if (keys_[s] == map::kEmptyKey) continue;
+  // only the slots in use: the table has several empty slots per cell
+  for (const std::uint32_t s : used_) {
     out.emplace_back(keys_[s], first_[s]);
     keys_[s] = map::kEmptyKey;
   }
-  cells_ = 0;
+  used_.clear();
 }
 
 const std::vector<std::int32_t>& CellDownsampler::first_of_each_cell(const std::uint64_t* keys, std::size_t n,
@@ -81,18 +84,16 @@ const std::vector<std::int32_t>& CellDownsampler::first_of_each_cell(const std::
 }
 
 const std::vector<std::int32_t>& CellDownsampler::merge_blocks(std::size_t blocks) {
-  // 2. merge the blocks' tables into the first (lowest index per cell), then its cells in key order
-  for (std::size_t b = 1; b < blocks; ++b) {
-    cells_.clear();
-    tables_[b].drain(cells_);
-    for (const auto& [key, index] : cells_) tables_[0].insert_min(key, index);
-  }
+  // 2. the blocks' cells one block after the other, sorted by key (stable: of a cell in several
+  //    blocks, the lowest block, with the lowest index, comes first), the first of each key kept
   cells_.clear();
-  tables_[0].drain(cells_);
+  for (std::size_t b = 0; b < blocks; ++b) tables_[b].drain(cells_);
   radix_sort_by_key(cells_, scratch_);
-  kept_.resize(cells_.size());
-  for (std::size_t c = 0; c < cells_.size(); ++c) kept_[c] = cells_[c].second;
-  expected_cells_ = cells_.size();
+  kept_.clear();
+  for (std::size_t c = 0; c < cells_.size(); ++c) {
+    if (c == 0 || cells_[c].first != cells_[c - 1].first) kept_.push_back(cells_[c].second);
+  }
+  expected_cells_ = kept_.size();
   return kept_;
 }
 

@@ -4,7 +4,8 @@
 // points falls into ~10k cells of the map spacing; sorting the points by cell cost more than all
 // the other preprocessing (docs/performance.md). Each thread deduplicates a contiguous block of
 // the scan into its own table (no atomics, no cache line shared between cores), skipping a point
-// whose neighbour in the scan order fell into the same cell; the tables are then merged.
+// whose neighbour in the scan order fell into the same cell; the blocks' cells are then sorted
+// together by key and the first of each cell kept.
 #include <algorithm>
 #include <array>
 #include <cstddef>
@@ -24,7 +25,8 @@ class CellTable {
   void reset(std::size_t expected_cells);
   /// Records `index` for `key` (keeps the lowest); grows when half full.
   void insert_min(std::uint64_t key, std::int32_t index);
-  /// Appends every (key, lowest index) to `out` and empties the table.
+  /// Appends every (key, lowest index) to `out` (in the order the cells arrived) and empties the
+  /// table, visiting only the slots in use.
   void drain(std::vector<std::pair<std::uint64_t, std::int32_t>>& out);
 
  private:
@@ -32,7 +34,7 @@ class CellTable {
 
   std::vector<std::uint64_t> keys_;
   std::vector<std::int32_t> first_;
-  std::size_t cells_ = 0;
+  std::vector<std::uint32_t> used_;  // the slots holding a cell, in insertion order
 };
 
 class CellDownsampler {
@@ -77,7 +79,7 @@ class CellDownsampler {
   /// the next point of a ring), so most repeats are caught there instead of by a table probe.
   static constexpr std::size_t kRecentCells = 512;
 
-  /// Merges the blocks' tables (lowest index per cell) and gives the cells' indices in key order.
+  /// The blocks' cells (lowest index per cell) in key order: their indices.
   const std::vector<std::int32_t>& merge_blocks(std::size_t blocks);
 
   std::vector<CellTable> tables_;  // one per block of the scan (a block per thread)
