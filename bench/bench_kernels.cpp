@@ -4,6 +4,7 @@
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <chrono>
 #include <limits>
 #include <memory>
 #include <numeric>
@@ -259,6 +260,26 @@ void BM_L2Probes(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(kProbes));
 }
 
+/// The cost of one parallel region on 2 threads: a loop of two tasks of about 20 us each,
+/// after a serial gap of range(0) microseconds of busy work (the serial parts of a frame between
+/// its parallel loops, during which the other thread may fall asleep). Real time per iteration,
+/// gap included: compare with the gap plus 20 us.
+void BM_ParallelRegion(benchmark::State& state) {
+  exec::CpuExecutor ex(2);
+  const auto gap = std::chrono::microseconds(state.range(0));
+  constexpr auto kTask = std::chrono::microseconds(20);
+  const auto spin = [](std::chrono::microseconds d) {
+    const auto until = std::chrono::steady_clock::now() + d;
+    while (std::chrono::steady_clock::now() < until) {
+    }
+  };
+  for (auto _ : state) {
+    spin(gap);
+    ex.for_each(
+        2, [&](std::size_t) { spin(kTask); }, 1);
+  }
+}
+
 /// Point-to-query squared distances over points held in L1 (the searches' inner loop,
 /// block_distances2), per thread count: the rate that bounds the neighbour searches.
 void BM_L1Distances(benchmark::State& state) {
@@ -278,6 +299,15 @@ BENCHMARK(BM_L1Distances)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRea
 BENCHMARK(BM_MemoryRead)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_MemoryLatency)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_L2Probes)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_ParallelRegion)
+    ->Arg(0)
+    ->Arg(100)
+    ->Arg(200)
+    ->Arg(300)
+    ->Arg(500)
+    ->Arg(2000)
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
 BENCHMARK(BM_Preprocess)->ArgsProduct({{1, 2}, {0, 1}})->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_MapInsert)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_NearestNeighbor)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
