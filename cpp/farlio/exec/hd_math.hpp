@@ -2,6 +2,8 @@
 // Small math helpers that Eigen 3.4 offers on the host only (allFinite is not a device
 // function), written once for the shared kernel bodies.
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 
 #include "farlio/exec/hd.hpp"
 
@@ -37,6 +39,19 @@ FARLIO_HD inline int floor_to_int(float x) {
   const int t = static_cast<int>(x);
   return t - static_cast<int>(x < static_cast<float>(t));
 #endif
+}
+
+/// The bits of a float and back (memcpy: defined behaviour on the host and the device). For
+/// x >= +0 the bits order as the values do.
+FARLIO_HD inline std::uint32_t float_bits(float x) {
+  std::uint32_t b;
+  memcpy(&b, &x, sizeof b);
+  return b;
+}
+FARLIO_HD inline float float_from_bits(std::uint32_t b) {
+  float x;
+  memcpy(&x, &b, sizeof x);
+  return x;
 }
 
 }  // namespace farlio::exec

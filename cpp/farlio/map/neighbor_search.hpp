@@ -7,6 +7,7 @@
 #include <cstdint>
 
 #include "farlio/exec/hd.hpp"
+#include "farlio/exec/hd_math.hpp"
 #include "farlio/map/map_view.hpp"
 
 namespace farlio::map {
@@ -139,37 +140,53 @@ FARLIO_HD inline std::int64_t nearest_neighbor(const ConstMapView& m, const Eige
   return best_index;
 }
 
+/// Bits of a candidate's visit position within its k-NN key: the point's slot in its voxel
+/// (below 1024 > kMaxPointsPerVoxel), above it the voxel's rank in the walk (below 32).
+inline constexpr int kSlotBits = 10;
+
 /// The k nearest points to p (k <= kMaxNeighbors) within sqrt(max_distance2), sorted by
-/// distance, over the voxels walk(bound2, visit) visits. Returns how many were found.
+/// distance, over the voxels walk(bound2, visit) visits; of equal distances the one visited first
+/// is the nearer. Returns how many were found. Each candidate is one 64-bit key, the distance's
+/// bits (ordered as the distances, which are >= 0) above its visit position, kept in a sorted
+/// list in the thread's own registers and stack: one word moves per shift of an insertion.
 template <typename Walk>
 FARLIO_HD int knn_over(const ConstMapView& m, const Walk& walk, const Eigen::Vector3f& p, int k, float max_distance2,
                        std::int64_t* indices, float* distances2) {
-  int found = 0;
-  auto bound = [&] { return found < k ? max_distance2 : distances2[k - 1]; };
-  walk(bound, [&](std::int32_t v) {
-    const std::int32_t n = m.voxel_counts[v];
-    const std::int64_t first = m.point_index(v, 0);
-    // distances of a block of points first, then the few that pass the bound are inserted
-    for (std::int32_t j0 = 0; j0 < n; j0 += kDistanceBlock) {
-      float block[kDistanceBlock];
-      const std::int32_t len = block_distances2(m, first + j0, n - j0, p, block);
-      float b = bound();
-      for (std::int32_t j = 0; j < len; ++j) {
-        const float d2 = block[j];
-        if (d2 >= b) continue;
-        // insertion into the sorted list
-        int pos = found < k ? found++ : k - 1;
-        while (pos > 0 && distances2[pos - 1] > d2) {
-          distances2[pos] = distances2[pos - 1];
-          indices[pos] = indices[pos - 1];
-          --pos;
-        }
-        distances2[pos] = d2;
-        indices[pos] = first + j0 + j;
-        b = bound();
-      }
-    }
-  });
+  std::uint64_t best[kMaxNeighbors];
+  std::int32_t walked[kNeighborVoxels];  // the voxels in visit order
+  int voxels = 0, found = 0;
+  float bound = max_distance2;
+  const Eigen::Vector3f query = p;  // a copy: the list's stores cannot alias it
+  walk([&] { return bound; },
+       [&](std::int32_t v) {
+         const auto rank = static_cast<std::uint64_t>(voxels);
+         walked[voxels++] = v;
+         const std::int32_t n = m.voxel_counts[v];
+         const std::int64_t first = m.point_index(v, 0);
+         // distances of a block of points first, then the few that pass the bound are inserted
+         for (std::int32_t j0 = 0; j0 < n; j0 += kDistanceBlock) {
+           float block[kDistanceBlock];
+           const std::int32_t len = block_distances2(m, first + j0, n - j0, query, block);
+           for (std::int32_t j = 0; j < len; ++j) {
+             if (!(block[j] < bound)) continue;
+             const std::uint64_t key = (static_cast<std::uint64_t>(exec::float_bits(block[j])) << 32) |
+                                       (rank << kSlotBits) | static_cast<std::uint64_t>(j0 + j);
+             int pos = found < k ? found++ : k - 1;
+             while (pos > 0 && best[pos - 1] > key) {
+               best[pos] = best[pos - 1];
+               --pos;
+             }
+             best[pos] = key;
+             if (found == k) bound = exec::float_from_bits(static_cast<std::uint32_t>(best[k - 1] >> 32));
+           }
+         }
+       });
+  constexpr std::uint64_t kSlotMask = (std::uint64_t{1} << kSlotBits) - 1;
+  for (int s = 0; s < found; ++s) {
+    const std::uint64_t position = best[s] & 0xffffffffULL;
+    indices[s] = m.point_index(walked[position >> kSlotBits], static_cast<std::int32_t>(position & kSlotMask));
+    distances2[s] = exec::float_from_bits(static_cast<std::uint32_t>(best[s] >> 32));
+  }
   return found;
 }
 
