@@ -64,6 +64,10 @@ DeviceVoxelMap::DeviceVoxelMap(const VoxelMapConfig& config, std::size_t voxel_c
   scratch.keys.require(voxel_capacity + 1, "cuda.max_scan_points");  // the scratch serves removals too
   high_water_ = capacity_;  // so that clear() empties the whole pool once: empty keys, no points
   clear();
+  // the point slots once, as the CPU pool's: a snapshot copies whole voxels, never memory nothing
+  // wrote (compute-sanitizer initcheck)
+  FARLIO_CUDA_CHECK(cudaMemsetAsync(points_.data(), 0, points_.bytes(), executor.stream()));
+  FARLIO_CUDA_CHECK(cudaMemsetAsync(covs_.data(), 0, covs_.bytes(), executor.stream()));
 }
 
 void DeviceVoxelMap::reconfigure(const VoxelMapConfig& config) {
@@ -337,6 +341,9 @@ KnnResults DeviceVoxelMap::knn(const std::vector<Eigen::Vector3f>& queries, int 
   DeviceBuffer<float> d2(nq * per, "queries");
   const cudaStream_t st = executor_->stream();
   q.upload(queries.data(), nq, st, "(queries)");
+  constexpr int kAllOnes = 0xFF;  // index -1, distance NaN: the ranks no neighbour fills
+  FARLIO_CUDA_CHECK(cudaMemsetAsync(idx.data(), kAllOnes, idx.bytes(), st));
+  FARLIO_CUDA_CHECK(cudaMemsetAsync(d2.data(), kAllOnes, d2.bytes(), st));
   const map::ConstMapView v = view();
   const Eigen::Vector3f* qp = q.data();
   int* fp = found.data();

@@ -83,7 +83,10 @@ FARLIO_HD inline PointShape classify_shape(const Eigen::Matrix3f& regularized_co
 /// Frobenius-norm regularisation of eq. (1).
 FARLIO_HD inline Eigen::Matrix3f regularize_frobenius(const Eigen::Matrix3f& sample_cov, float epsilon) {
   const Eigen::Matrix3f c = sample_cov + epsilon * Eigen::Matrix3f::Identity();
-  return c.inverse().norm() * c;
+  // The inverse into a matrix first: Eigen 3.4's norm() of the inverse expression compiles to a
+  // trap in device code (seen on an H200: every covariance kernel stopped there).
+  const Eigen::Matrix3f inverse = c.inverse();
+  return inverse.norm() * c;
 }
 
 }  // namespace farlio::map
