@@ -1,19 +1,25 @@
 // Times the whole scan pipeline (undistortion, downsampling, source covariances, GICP, map
-// update) per frame on generated sequences, on the GPU (or the CPU), and prints a short table:
-// median / p99 / max per frame, the device-timed stages, device memory, and the pose agreement
-// with the CPU backend on the same scans; then the effective bandwidth of the k-NN and the GICP
+// update) per frame on generated sequences and on folders of recorded scans, on the GPU and the
+// CPU over the same scans, and prints a short table: median / p99 / max per frame, each stage's
+// median and p99 (CUDA events on the GPU), device memory, and the pose agreement of the two
+// backends; then the scan's upload time and the effective bandwidth of the k-NN and the GICP
 // reduction against a device-to-device copy. Run by scripts/gpu_check.sh.
-// Usage: gpu_pipeline [--frames N] [--profile urban|racetrack|handheld|tunnel]... [--device cuda|cpu|auto]
-//                     [--no-cpu-compare] [--repeats R]
+// Usage: gpu_pipeline [--frames N] [--profile urban|racetrack|handheld|tunnel]... [--scans DIR]...
+//                     [--device cuda|cpu|auto] [--no-cpu-compare] [--repeats R]
+// --scans DIR: every point cloud file of DIR (PCD, PLY, KITTI .bin, optionally .gz), in name
+// order, as scans 0.1 s apart without per-point times (KITTI's scans are already undistorted).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "farlio/io/point_cloud_io.hpp"
 #include "farlio/pipeline/scan_pipeline.hpp"
 #include "farlio/sim/sequence_generator.hpp"
 #ifdef FARLIO_WITH_CUDA
@@ -32,10 +38,14 @@ constexpr int kDefaultRepeats = 20;
 constexpr double kMsPerS = 1e3;
 constexpr double kMiB = 1024.0 * 1024.0;
 constexpr double kMedian = 0.5, kP99 = 0.99;
+constexpr std::int64_t kRecordedScanPeriod_ns = 100'000'000;  // 10 Hz
+constexpr int kStages = 4;
+constexpr const char* kStageNames[kStages] = {"prep", "source", "gicp", "update"};
 
 struct Options {
   std::size_t frames = kDefaultFrames;
   std::vector<std::string> profiles;
+  std::vector<std::string> scan_dirs;
   Device device = Device::Cuda;
   bool compare_cpu = true;
   int repeats = kDefaultRepeats;
@@ -53,6 +63,8 @@ Options parse(int argc, char** argv) {
       o.frames = std::stoul(value());
     else if (a == "--profile")
       o.profiles.push_back(value());
+    else if (a == "--scans")
+      o.scan_dirs.push_back(value());
     else if (a == "--device")
       o.device = parse_device(value(), "--device");
     else if (a == "--no-cpu-compare")
@@ -62,7 +74,7 @@ Options parse(int argc, char** argv) {
     else
       throw std::invalid_argument("unknown option " + a + " (see the comment at the top of bench/gpu_pipeline.cpp)");
   }
-  if (o.profiles.empty()) o.profiles = {"urban", "racetrack"};
+  if (o.profiles.empty() && o.scan_dirs.empty()) o.profiles = {"urban", "racetrack"};
   return o;
 }
 
@@ -82,6 +94,25 @@ std::vector<Scan> generate(const std::string& profile, std::size_t frames) {
   return scans;
 }
 
+/// The first `frames` point cloud files of dir in name order, 0.1 s apart.
+std::vector<Scan> read_scans(const std::string& dir, std::size_t frames) {
+  std::vector<std::filesystem::path> files;
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    if (e.is_regular_file() && io::is_point_cloud_file(e.path())) files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  if (files.empty()) throw std::invalid_argument("--scans " + dir + ": no point cloud file in it");
+  if (files.size() > frames) files.resize(frames);
+  std::vector<Scan> scans;
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    Scan s = io::read_point_cloud(files[i]);
+    s.remove_non_finite();
+    s.start_stamp_ns = static_cast<std::int64_t>(i) * kRecordedScanPeriod_ns;
+    s.end_stamp_ns = s.start_stamp_ns + kRecordedScanPeriod_ns;
+    scans.push_back(std::move(s));
+  }
+  return scans;
+}
+
 /// Device memory in use (bytes), or 0 without CUDA.
 double device_used_bytes() {
 #ifdef FARLIO_WITH_CUDA
@@ -92,7 +123,7 @@ double device_used_bytes() {
 }
 
 struct Run {
-  std::vector<double> total_ms, stage_ms[4];
+  std::vector<double> total_ms, stage_ms[kStages];
   std::vector<SE3> poses;
   double prealloc_bytes = 0.0, used_bytes = 0.0;
   std::size_t max_voxels = 0;
@@ -105,9 +136,9 @@ Run run(pipeline::ScanPipeline& p, const std::vector<Scan>& scans, double used_b
     const auto t0 = std::chrono::steady_clock::now();
     const auto f = p.process(s);
     r.total_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-    const double st[4] = {f.timings.preprocess_s, f.timings.covariance_s, f.timings.registration_s,
-                          f.timings.map_update_s};
-    for (int k = 0; k < 4; ++k) r.stage_ms[k].push_back(st[k] * kMsPerS);
+    const double st[kStages] = {f.timings.preprocess_s, f.timings.covariance_s, f.timings.registration_s,
+                                f.timings.map_update_s};
+    for (int k = 0; k < kStages; ++k) r.stage_ms[k].push_back(st[k] * kMsPerS);
     r.poses.push_back(f.pose);
     r.max_voxels = std::max(r.max_voxels, f.map_voxels);
     r.device_timed = f.timings.device_timed;
@@ -117,19 +148,32 @@ Run run(pipeline::ScanPipeline& p, const std::vector<Scan>& scans, double used_b
   return r;
 }
 
-void print_bandwidth(pipeline::ScanPipeline& p, int repeats) {
+void print_row(const std::string& name, double points, Device device, const Run& r, double dt, double dr) {
+  std::printf("%-12s %7.0f %6s %6zu %9.2f %8.2f %8.2f | %9.1f %9.1f | %9.2e %10.2e | %7zu\n", name.c_str(), points,
+              device_name(device), r.total_ms.size(), quantile(r.total_ms, kMedian), quantile(r.total_ms, kP99),
+              quantile(r.total_ms, 1.0), r.prealloc_bytes / kMiB, r.used_bytes / kMiB, dt, dr, r.max_voxels);
+  std::printf("    stages (%s), median / p99 ms:", r.device_timed ? "CUDA events" : "wall clock");
+  for (int k = 0; k < kStages; ++k)
+    std::printf("  %s %.3f / %.3f", kStageNames[k], quantile(r.stage_ms[k], kMedian), quantile(r.stage_ms[k], kP99));
+  std::printf("\n");
+}
+
+void print_bandwidth(pipeline::ScanPipeline& p, int repeats, double frame_median_ms) {
 #ifdef FARLIO_WITH_CUDA
   if (p.backend().device() != Device::Cuda) return;
   const auto samples = cuda::measure_kernel_bandwidth(p.backend(), repeats);
   const double ceiling = samples.front().gb_per_s();
-  std::printf("  %-22s %10s %12s %10s %10s\n", "kernel", "ms", "MB asked", "GB/s", "of copy");
+  std::printf("    %-22s %10s %12s %10s %10s\n", "kernel", "ms", "MB asked", "GB/s", "of copy");
   for (const auto& s : samples) {
-    std::printf("  %-22s %10.3f %12.1f %10.1f %9.0f%%\n", s.kernel.c_str(), s.ms, s.bytes / 1e6, s.gb_per_s(),
+    std::printf("    %-22s %10.3f %12.1f %10.1f %9.0f%%\n", s.kernel.c_str(), s.ms, s.bytes / 1e6, s.gb_per_s(),
                 100.0 * s.gb_per_s() / ceiling);
+    if (s.kernel.rfind("scan upload", 0) == 0)
+      std::printf("    (the last scan's upload is %.1f %% of the median frame)\n", 100.0 * s.ms / frame_median_ms);
   }
 #else
   (void)p;
   (void)repeats;
+  (void)frame_median_ms;
 #endif
 }
 
@@ -139,11 +183,13 @@ int main(int argc, char** argv) {
   try {
     const Options o = parse(argc, argv);
     resolve_device(o.device);  // cuda without a GPU: the error before anything else
-    std::printf("%-10s %7s %6s %6s %9s %8s %8s | %8s %8s %8s %8s | %9s %9s | %9s %10s | %7s\n", "profile", "points",
-                "device", "frames", "median ms", "p99 ms", "max ms", "prep", "source", "gicp", "update", "prealloc",
-                "used MiB", "dt_max m", "dr_max deg", "voxels");
-    for (const auto& profile : o.profiles) {
-      const std::vector<Scan> scans = generate(profile, o.frames);
+    std::printf("%-12s %7s %6s %6s %9s %8s %8s | %9s %9s | %9s %10s | %7s\n", "sequence", "points", "device", "frames",
+                "median ms", "p99 ms", "max ms", "prealloc", "used MiB", "dt_max m", "dr_max deg", "voxels");
+    std::vector<std::pair<std::string, std::vector<Scan>>> sequences;
+    for (const auto& profile : o.profiles) sequences.emplace_back(profile, generate(profile, o.frames));
+    for (const auto& dir : o.scan_dirs)
+      sequences.emplace_back(std::filesystem::path(dir).filename().string(), read_scans(dir, o.frames));
+    for (const auto& [name, scans] : sequences) {
       double points = 0;
       for (const auto& s : scans) points += static_cast<double>(s.size()) / static_cast<double>(scans.size());
       Config cfg;
@@ -152,27 +198,26 @@ int main(int argc, char** argv) {
       pipeline::ScanPipeline p(cfg);
       if (!p.device_message().empty()) std::fprintf(stderr, "%s\n", p.device_message().c_str());
       const Run r = run(p, scans, used_before);
-      double dt = NAN, dr = NAN;
       if (o.compare_cpu && p.backend().device() != Device::Cpu) {
         Config c = cfg;
         c.device = Device::Cpu;
         pipeline::ScanPipeline cpu(c);
-        const Run rc = run(cpu, scans, 0.0);
-        dt = dr = 0.0;
+        Run rc = run(cpu, scans, 0.0);
+        rc.used_bytes = NAN;  // the CPU backend uses no device memory
+        double dt = 0.0, dr = 0.0;
         for (std::size_t i = 0; i < scans.size(); ++i) {
           const SE3 d = rc.poses[i].inverse() * r.poses[i];
           dt = std::max(dt, d.translation().norm());
           dr = std::max(dr, d.angle_rad() * 180.0 / M_PI);
         }
+        print_row(name, points, p.backend().device(), r, dt, dr);
+        print_row(name, points, Device::Cpu, rc, NAN, NAN);
+        std::printf("    GPU faster than the CPU (median): %.1fx\n",
+                    quantile(rc.total_ms, kMedian) / quantile(r.total_ms, kMedian));
+      } else {
+        print_row(name, points, p.backend().device(), r, NAN, NAN);
       }
-      std::printf(
-          "%-10s %7.0f %6s %6zu %9.2f %8.2f %8.2f | %8.2f %8.2f %8.2f %8.2f | %9.1f %9.1f | %9.2e %10.2e | %7zu\n",
-          profile.c_str(), points, device_name(p.backend().device()), scans.size(), quantile(r.total_ms, kMedian),
-          quantile(r.total_ms, kP99), quantile(r.total_ms, 1.0), quantile(r.stage_ms[0], kMedian),
-          quantile(r.stage_ms[1], kMedian), quantile(r.stage_ms[2], kMedian), quantile(r.stage_ms[3], kMedian),
-          r.prealloc_bytes / kMiB, r.used_bytes / kMiB, dt, dr, r.max_voxels);
-      std::printf("  stages: median ms, %s\n", r.device_timed ? "CUDA events" : "wall clock");
-      print_bandwidth(p, o.repeats);
+      print_bandwidth(p, o.repeats, quantile(r.total_ms, kMedian));
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "gpu_pipeline: error: %s\n", e.what());

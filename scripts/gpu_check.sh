@@ -1,74 +1,151 @@
 #!/usr/bin/env bash
-# The GPU check of the CUDA backend, in one call on a machine with an NVIDIA GPU, the repository
-# and the Debian packages of scripts/install_deps.sh (no .venv needed):
-#   1. configure and build with CUDA (Release, this GPU's architecture);
+# The GPU check of the CUDA backend, in one call on a machine with an NVIDIA GPU:
+#   1. build Release for this GPU's architecture (or take a build packed with --pack, below);
 #   2. run the GPU tests (GPU vs CPU: map contents, k-NN, covariances, 100-frame trajectory);
-#   3. run them under compute-sanitizer memcheck and racecheck (without the 100-frame test,
-#      whose kernels the short pipeline test runs too);
-#   4. time the scan pipeline on generated urban and racetrack sequences (bench/gpu_pipeline):
-#      median, p99, device memory, CPU/GPU agreement, k-NN and reduction bandwidth vs a copy.
-# Environment: BUILD (build folder, default build/gpu), CUDA_ARCH (default native), FRAMES
-# (default 100), JOBS (default nproc), SKIP_SANITIZERS=1.
+#   3. time the scan pipeline, GPU and CPU on the same scans (bench/gpu_pipeline): generated
+#      urban and racetrack sequences and, with SCANS=DIR, a folder of recorded scans: median, p99
+#      and max per frame, each stage's median and p99, device memory, CPU/GPU agreement, the
+#      scan's upload, k-NN and reduction bandwidth against a device-to-device copy;
+#   4. run the GPU tests under compute-sanitizer memcheck, racecheck and initcheck (without the
+#      100-frame test, whose kernels the short pipeline test runs too).
+# Every step runs even when an earlier one failed, under its own time limit; the logs go to
+# $OUT (or $BUILD/gpu_check) and a summary of the steps is printed last. The exit status is 0
+# only if every step passed; 3 when compute-sanitizer is missing, so that a run without the
+# sanitizers cannot pass for one with them.
+# Environment: BUILD (default build/gpu), CUDA_ARCH (default native), FRAMES (default 100),
+# JOBS (default nproc), SCANS (a folder of scans for the timing), SKIP_SANITIZERS=1,
+# PREBUILT (a folder made by --pack: run its binaries, build nothing).
 #
-# A GPU image without the build dependencies (Eigen, TBB, yaml-cpp, GoogleTest) can take them
-# as Debian 12 packages: run `scripts/gpu_check.sh --fetch-debs` on a Debian machine first (it
-# downloads them into .gpu-debs/, which git ignores), carry .gpu-debs to the GPU machine, and this
-# script unpacks them into .gpu-debs/root (never into /) and builds against them.
-set -euo pipefail
+#   scripts/gpu_check.sh --pack DIR   (on the build machine, after building BUILD with CUDA)
+# copies the two executables, stripped, and the shared libraries they need that are not the C
+# and C++ runtime into DIR/bin and DIR/lib, so that a GPU machine without the build dependencies
+# (or with too little time to build) can run PREBUILT=DIR scripts/gpu_check.sh.
+#
+#   scripts/gpu_check.sh --fetch-debs
+# downloads the build dependencies (Eigen, TBB, yaml-cpp, GoogleTest) as Debian 12 packages into
+# .gpu-debs/ (ignored by git); carried to a GPU image without them, the script unpacks them into
+# .gpu-debs/root (never into /) and builds against them.
+set -uo pipefail
 cd "$(dirname "$0")/.."
 
+BUILD=${BUILD:-build/gpu}
+EXECUTABLES=(tests/cuda/test_cuda_backend bench/gpu_pipeline)
 DEBS=.gpu-debs
 DEB_PACKAGES=(libeigen3-dev libtbb-dev libtbb12 libtbbmalloc2 libtbbbind-2-5 libhwloc15 libyaml-cpp-dev
               libyaml-cpp0.7 libgtest-dev googletest zlib1g-dev)
-if [ "${1:-}" = --fetch-debs ]; then
-  mkdir -p "$DEBS"
-  (cd "$DEBS" && apt-get download "${DEB_PACKAGES[@]}")
-  echo "downloaded into $DEBS: carry it to the GPU machine"
-  exit 0
-fi
-if compgen -G "$DEBS/*.deb" >/dev/null; then
-  root="$PWD/$DEBS/root"
-  mkdir -p "$root"
-  for deb in "$DEBS"/*.deb; do dpkg-deb -x "$deb" "$root"; done
-  export CMAKE_PREFIX_PATH="$root/usr${CMAKE_PREFIX_PATH:+:$CMAKE_PREFIX_PATH}"
-  export LD_LIBRARY_PATH="$root/usr/lib/x86_64-linux-gnu${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
-  echo "== build dependencies from $DEBS (unpacked into $root) =="
-fi
-BUILD=${BUILD:-build/gpu}
+# The libraries every Linux machine has (C runtime, C++ runtime, the dynamic loader): not packed.
+SYSTEM_LIBS='^(linux-vdso|libc\.|libm\.|libdl\.|libpthread\.|librt\.|libgcc_s\.|libstdc\+\+\.|ld-linux)'
+
+case "${1:-}" in
+  --fetch-debs)
+    mkdir -p "$DEBS"
+    (cd "$DEBS" && apt-get download "${DEB_PACKAGES[@]}")
+    echo "downloaded into $DEBS: carry it to the GPU machine"
+    exit 0 ;;
+  --pack)
+    dest=${2:?--pack needs a folder}
+    mkdir -p "$dest/bin" "$dest/lib"
+    for exe in "${EXECUTABLES[@]}"; do
+      [ -x "$BUILD/$exe" ] || { echo "missing $BUILD/$exe: build it first" >&2; exit 2; }
+      strip -o "$dest/bin/$(basename "$exe")" "$BUILD/$exe"
+      ldd "$BUILD/$exe" | awk '$3 ~ /^\// {print $3}' | while read -r lib; do
+        basename "$lib" | grep -Eq "$SYSTEM_LIBS" || cp -L "$lib" "$dest/lib/"
+      done
+    done
+    du -sh "$dest/bin" "$dest/lib"
+    exit 0 ;;
+esac
+
 CUDA_ARCH=${CUDA_ARCH:-native}
 FRAMES=${FRAMES:-100}
 JOBS=${JOBS:-$(nproc)}
 CUDA_BIN=/usr/local/cuda/bin
 export PATH="$PATH:$CUDA_BIN"
 LONG_TEST=CudaPipeline.HundredUrbanFramesAgreeWithTheCpu
+LOGS=${OUT:-$BUILD/gpu_check}
+mkdir -p "$LOGS"
+# seconds each step may take (one lease of a GPU machine holds all of them)
+TESTS_LIMIT_S=${TESTS_LIMIT_S:-120}
+BENCH_LIMIT_S=${BENCH_LIMIT_S:-180}
+SANITIZER_LIMIT_S=${SANITIZER_LIMIT_S:-150}
+
+summary=()
+status=0
+# step NAME LOG COMMAND...: runs the command under its time limit, its output into LOG and on
+# the terminal, and notes how it ended.
+step() {
+  local name=$1 log=$2 limit=$3
+  shift 3
+  echo "== $name =="
+  local start=$SECONDS
+  timeout "$limit" "$@" 2>&1 | tee "$LOGS/$log"
+  local rc=${PIPESTATUS[0]}
+  local verdict=passed
+  [ "$rc" = 124 ] && verdict="stopped after ${limit} s" || { [ "$rc" != 0 ] && verdict="FAILED (exit $rc)"; }
+  summary+=("$(printf '%-28s %-22s %4d s   %s' "$name" "$verdict" $((SECONDS - start)) "$LOGS/$log")")
+  return "$rc"
+}
 
 echo "== GPU =="
-nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv,noheader || true
+nvidia-smi --query-gpu=name,memory.total,driver_version,clocks.sm,clocks.max.sm --format=csv,noheader || true
 
-echo "== build (CUDA architectures: $CUDA_ARCH) =="
-generator=()
-command -v ninja >/dev/null && generator=(-G Ninja)
-cmake -S . -B "$BUILD" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release -DFARLIO_CUDA=ON \
-  -DCMAKE_CUDA_ARCHITECTURES="$CUDA_ARCH" -DFARLIO_BUILD_TESTS=ON -DFARLIO_BUILD_BENCHMARKS=ON >/dev/null
-cmake --build "$BUILD" -j "$JOBS" --target test_cuda_backend gpu_pipeline
+echo "host: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), $(nproc) threads"
 
-echo "== GPU tests =="
-"$BUILD/tests/cuda/test_cuda_backend"
+build_here() {
+  if compgen -G "$DEBS/*.deb" >/dev/null; then
+    local root="$PWD/$DEBS/root"
+    mkdir -p "$root"
+    for deb in "$DEBS"/*.deb; do dpkg-deb -x "$deb" "$root"; done
+    export CMAKE_PREFIX_PATH="$root/usr${CMAKE_PREFIX_PATH:+:$CMAKE_PREFIX_PATH}"
+    export LD_LIBRARY_PATH="$root/usr/lib/x86_64-linux-gnu${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+    echo "== build dependencies from $DEBS (unpacked into $root) =="
+  fi
+  echo "== build (CUDA architectures: $CUDA_ARCH) =="
+  local generator=()
+  command -v ninja >/dev/null && generator=(-G Ninja)
+  cmake -S . -B "$BUILD" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release -DFARLIO_CUDA=ON \
+    -DCMAKE_CUDA_ARCHITECTURES="$CUDA_ARCH" -DFARLIO_BUILD_TESTS=ON -DFARLIO_BUILD_BENCHMARKS=ON >/dev/null &&
+    cmake --build "$BUILD" -j "$JOBS" --target test_cuda_backend gpu_pipeline || exit 2
+  bin="$BUILD/bin"
+  mkdir -p "$bin"
+  for exe in "${EXECUTABLES[@]}"; do ln -sf "$PWD/$BUILD/$exe" "$bin/"; done
+}
 
-sanitizer_status=0
+if [ -n "${PREBUILT:-}" ]; then
+  bin="$PREBUILT/bin"
+  export LD_LIBRARY_PATH="$PWD/$PREBUILT/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+  echo "== prebuilt executables from $PREBUILT =="
+  if ! "$bin/test_cuda_backend" --gtest_list_tests >/dev/null || ! "$bin/gpu_pipeline" --frames 0 --device cpu >/dev/null; then
+    echo "the prebuilt executables do not run here: building instead" >&2
+    build_here
+  fi
+else
+  build_here
+fi
+
+step "GPU tests" tests.log "$TESTS_LIMIT_S" "$bin/test_cuda_backend" || status=1
+
+bench_args=(--frames "$FRAMES" --profile urban --profile racetrack)
+[ -n "${SCANS:-}" ] && bench_args+=(--scans "$SCANS")
+step "scan pipeline timing" timing.log "$BENCH_LIMIT_S" "$bin/gpu_pipeline" "${bench_args[@]}" || status=1
+
 if [ "${SKIP_SANITIZERS:-0}" != 1 ]; then
   SANITIZER=$(command -v compute-sanitizer || true)
   if [ -z "$SANITIZER" ]; then
     echo "compute-sanitizer not found (PATH, $CUDA_BIN): sanitizer runs NOT done" >&2
-    sanitizer_status=3
+    summary+=("compute-sanitizer            NOT FOUND")
+    [ "$status" = 0 ] && status=3
   else
-    for tool in memcheck racecheck; do
-      echo "== compute-sanitizer --tool $tool =="
-      "$SANITIZER" --tool "$tool" --error-exitcode 1 "$BUILD/tests/cuda/test_cuda_backend" --gtest_filter="-$LONG_TEST"
+    for tool in memcheck racecheck initcheck; do
+      step "compute-sanitizer $tool" "$tool.log" "$SANITIZER_LIMIT_S" "$SANITIZER" --tool "$tool" --error-exitcode 1 \
+        "$bin/test_cuda_backend" --gtest_filter="-$LONG_TEST" || status=1
     done
   fi
 fi
 
-echo "== scan pipeline timing ($FRAMES frames per sequence) =="
-"$BUILD/bench/gpu_pipeline" --frames "$FRAMES" --profile urban --profile racetrack
-exit "$sanitizer_status"
+echo "== summary =="
+printf '%s\n' "${summary[@]}" | tee "$LOGS/summary.txt"
+cat "$LOGS/timing.log" 2>/dev/null || true
+grep -h 'agreement\|preallocates\|FAILED' "$LOGS/tests.log" || true
+grep -h 'ERROR SUMMARY\|RACECHECK SUMMARY' "$LOGS"/*check.log 2>/dev/null || true
+exit "$status"

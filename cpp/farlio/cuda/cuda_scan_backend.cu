@@ -69,6 +69,7 @@ class CudaScanBackend final : public pipeline::ScanBackend {
     timer_.new_frame();
     timer_.start(StageTimer::kPreprocess);
     const std::size_t n = scan.size();
+    upload_bytes_ = n * (sizeof(Eigen::Vector3f) + (undistort ? sizeof(float) : 0));
     raw_.upload(scan.points.data(), n, executor_.stream(), kScanParameter);
     if (undistort) times_.upload(scan.time_s.data(), n, executor_.stream(), kScanParameter);
     frame_size_ =
@@ -185,6 +186,7 @@ class CudaScanBackend final : public pipeline::ScanBackend {
 
   std::vector<BandwidthSample> measure_bandwidth(int repeats) {
     std::vector<BandwidthSample> out{measure_copy(executor_, kCopyBytes, repeats)};
+    if (upload_bytes_ > 0) out.push_back(measure_upload(executor_, upload_bytes_, repeats));
     const std::size_t n = map_.num_points();
     DeviceBuffer<Eigen::Vector4f> points(n, "map points");
     DeviceBuffer<map::Cov3> covs(n, "map points");
@@ -214,7 +216,8 @@ class CudaScanBackend final : public pipeline::ScanBackend {
   DeviceBuffer<map::Cov3> source_covs_;
   std::size_t frame_size_ = 0;
   std::size_t source_size_ = 0;
-  SE3 last_pose_;  // of the last map update (the bandwidth measurement's GICP pose)
+  std::size_t upload_bytes_ = 0;  // of the last scan (points, and times when undistorted)
+  SE3 last_pose_;                 // of the last map update (the bandwidth measurement's GICP pose)
   StageTimer timer_;
 };
 

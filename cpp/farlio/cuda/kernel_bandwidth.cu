@@ -89,6 +89,14 @@ BandwidthSample measure_copy(CudaExecutor& ex, std::size_t bytes, int repeats) {
   return s;
 }
 
+BandwidthSample measure_upload(CudaExecutor& ex, std::size_t bytes, int repeats) {
+  const std::vector<unsigned char> host(bytes, 1);
+  DeviceBuffer<unsigned char> device(bytes, "upload bytes");
+  BandwidthSample s{"scan upload (host)", 0.0, static_cast<double>(bytes)};
+  s.ms = median_ms(ex, repeats, [&] { device.upload(host.data(), bytes, ex.stream(), "upload bytes"); });
+  return s;
+}
+
 BandwidthSample measure_knn(CudaExecutor& ex, const map::ConstMapView& m, const Eigen::Vector4f* points, std::size_t n,
                             int k, float max_distance2, int repeats) {
   DeviceBuffer<std::int64_t> idx(n * static_cast<std::size_t>(k), "k-NN results");

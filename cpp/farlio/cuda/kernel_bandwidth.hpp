@@ -25,6 +25,10 @@ struct BandwidthSample {
 /// The copy ceiling: `bytes` copied from one device buffer to another (allocates both).
 BandwidthSample measure_copy(CudaExecutor& executor, std::size_t bytes, int repeats);
 
+/// The upload of a scan: `bytes` copied from pageable host memory to the device, as the backend
+/// copies each scan (DeviceBuffer::upload from the caller's vectors).
+BandwidthSample measure_upload(CudaExecutor& executor, std::size_t bytes, int repeats);
+
 /// k-NN of n device points in `target` (k neighbours within sqrt(max_distance2)).
 BandwidthSample measure_knn(CudaExecutor& executor, const map::ConstMapView& target, const Eigen::Vector4f* points,
                             std::size_t n, int k, float max_distance2, int repeats);
