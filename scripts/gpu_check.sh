@@ -7,14 +7,18 @@
 #      and max per frame, each stage's median and p99, device memory, CPU/GPU agreement, the
 #      scan's upload, k-NN and reduction bandwidth against a device-to-device copy;
 #   4. run the GPU tests under compute-sanitizer memcheck, racecheck and initcheck (without the
-#      100-frame test, whose kernels the short pipeline test runs too).
+#      100-frame and odometry tests, whose kernels the short pipeline test runs too);
+#   5. with PYTHON=1: build the Python package there (pip, no index: the GPU image's own
+#      scikit-build-core, nanobind, numpy, matplotlib, PyYAML) and run the command line tool on the
+#      GPU: `farlio run --device cuda` and `--device cpu` on a generated 10 s urban sequence (their
+#      summaries side by side), then `farlio bench --device cuda` (and on SCANS).
 # Every step runs even when an earlier one failed, under its own time limit; the logs go to
 # $OUT (or $BUILD/gpu_check) and a summary of the steps is printed last. The exit status is 0
 # only if every step passed; 3 when compute-sanitizer is missing, so that a run without the
 # sanitizers cannot pass for one with them.
 # Environment: BUILD (default build/gpu), CUDA_ARCH (default native), FRAMES (default 100),
 # JOBS (default nproc), SCANS (a folder of scans for the timing), SKIP_SANITIZERS=1,
-# PREBUILT (a folder made by --pack: run its binaries, build nothing).
+# PREBUILT (a folder made by --pack: run its binaries, build nothing), PYTHON=1.
 #
 #   scripts/gpu_check.sh --pack DIR   (on the build machine, after building BUILD with CUDA)
 # copies the two executables, stripped, and the shared libraries they need that are not the C
@@ -32,7 +36,7 @@ BUILD=${BUILD:-build/gpu}
 EXECUTABLES=(tests/cuda/test_cuda_backend bench/gpu_pipeline)
 DEBS=.gpu-debs
 DEB_PACKAGES=(libeigen3-dev libtbb-dev libtbb12 libtbbmalloc2 libtbbbind-2-5 libhwloc15 libyaml-cpp-dev
-              libyaml-cpp0.7 libgtest-dev googletest zlib1g-dev)
+              libyaml-cpp0.7 libgtest-dev googletest zlib1g-dev zlib1g)
 # The libraries every Linux machine has (C runtime, C++ runtime, the dynamic loader): not packed.
 SYSTEM_LIBS='^(linux-vdso|libc\.|libm\.|libdl\.|libpthread\.|librt\.|libgcc_s\.|libstdc\+\+\.|ld-linux)'
 
@@ -61,13 +65,15 @@ FRAMES=${FRAMES:-100}
 JOBS=${JOBS:-$(nproc)}
 CUDA_BIN=/usr/local/cuda/bin
 export PATH="$PATH:$CUDA_BIN"
-LONG_TEST=CudaPipeline.HundredUrbanFramesAgreeWithTheCpu
+# the long GPU-vs-CPU runs stay out of the sanitizer runs (the short pipeline test runs every kernel)
+LONG_TESTS=CudaPipeline.HundredUrbanFramesAgreeWithTheCpu:Profiles/CudaOdometry.*
 LOGS=${OUT:-$BUILD/gpu_check}
 mkdir -p "$LOGS"
 # seconds each step may take (one lease of a GPU machine holds all of them)
 TESTS_LIMIT_S=${TESTS_LIMIT_S:-120}
 BENCH_LIMIT_S=${BENCH_LIMIT_S:-180}
 SANITIZER_LIMIT_S=${SANITIZER_LIMIT_S:-150}
+PYTHON_LIMIT_S=${PYTHON_LIMIT_S:-420}
 
 summary=()
 status=0
@@ -91,15 +97,26 @@ nvidia-smi --query-gpu=name,memory.total,driver_version,clocks.sm,clocks.max.sm 
 
 echo "host: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), $(nproc) threads"
 
+# The build dependencies from .gpu-debs (--fetch-debs), when there: unpacked once, for CMake.
+use_debs() {
+  compgen -G "$DEBS/*.deb" >/dev/null || return 0
+  [ -n "${DEBS_IN_USE:-}" ] && return 0
+  local root="$PWD/$DEBS/root"
+  mkdir -p "$root"
+  for deb in "$DEBS"/*.deb; do dpkg-deb -x "$deb" "$root"; done
+  # Debian's development links are absolute (/lib/...): point them into the unpacked tree
+  local link
+  for link in "$root"/usr/lib/x86_64-linux-gnu/*.so; do
+    [ -L "$link" ] && [ "$(readlink "$link" | cut -c1)" = / ] && ln -sf "$root$(readlink "$link")" "$link"
+  done
+  export CMAKE_PREFIX_PATH="$root/usr${CMAKE_PREFIX_PATH:+:$CMAKE_PREFIX_PATH}"
+  export LD_LIBRARY_PATH="$root/usr/lib/x86_64-linux-gnu${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+  DEBS_IN_USE=1
+  echo "== build dependencies from $DEBS (unpacked into $root) =="
+}
+
 build_here() {
-  if compgen -G "$DEBS/*.deb" >/dev/null; then
-    local root="$PWD/$DEBS/root"
-    mkdir -p "$root"
-    for deb in "$DEBS"/*.deb; do dpkg-deb -x "$deb" "$root"; done
-    export CMAKE_PREFIX_PATH="$root/usr${CMAKE_PREFIX_PATH:+:$CMAKE_PREFIX_PATH}"
-    export LD_LIBRARY_PATH="$root/usr/lib/x86_64-linux-gnu${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
-    echo "== build dependencies from $DEBS (unpacked into $root) =="
-  fi
+  use_debs
   echo "== build (CUDA architectures: $CUDA_ARCH) =="
   local generator=()
   command -v ninja >/dev/null && generator=(-G Ninja)
@@ -138,9 +155,43 @@ if [ "${SKIP_SANITIZERS:-0}" != 1 ]; then
   else
     for tool in memcheck racecheck initcheck; do
       step "compute-sanitizer $tool" "$tool.log" "$SANITIZER_LIMIT_S" "$SANITIZER" --tool "$tool" --error-exitcode 1 \
-        "$bin/test_cuda_backend" --gtest_filter="-$LONG_TEST" || status=1
+        "$bin/test_cuda_backend" --gtest_filter="-$LONG_TESTS" || status=1
     done
   fi
+fi
+
+# The Python package and the command line tool on the GPU (step 5).
+python_check() {
+  local site=/tmp/farlio-gpu-site seq=/tmp/farlio-gpu-seq runs=/tmp/farlio-gpu-runs
+  rm -rf "$site" "$seq" "$runs"
+  echo "-- pip install (Release, CUDA architectures $CUDA_ARCH) --"
+  FARLIO_CUDA=ON FARLIO_CUDA_ARCHITECTURES="$CUDA_ARCH" CMAKE_BUILD_PARALLEL_LEVEL="$JOBS" \
+    python3 -m pip install -q --no-build-isolation --no-deps --no-index --target "$site" . || return 1
+  export PYTHONPATH="$site${PYTHONPATH:+:$PYTHONPATH}"
+  local farlio=(python3 -c "import sys; from farlio.cli import main; sys.exit(main())")
+  "${farlio[@]}" info || return 1
+  "${farlio[@]}" simulate urban --duration 10 --out "$seq" --no-progress >/dev/null || return 1
+  for device in cuda cpu; do
+    "${farlio[@]}" run "$seq" --device "$device" --out "$runs/$device" --no-plot --no-progress || return 1
+  done
+  python3 - "$runs" <<'PY' || return 1
+import json, sys
+for device in ("cuda", "cpu"):
+    s = json.load(open(f"{sys.argv[1]}/{device}/summary.json"))
+    a = s["accuracy"]
+    print(f"farlio run --device {device}: ran on {s['device']}, {s['frames']} frames, {s['fused']} fused, "
+          f"latency {s['latency_ms']}, APE {a['ape']['translation_m']['rmse']:.4f} m / "
+          f"{a['ape']['rotation_deg']['rmse']:.3f} deg, KITTI RPE {json.dumps(a.get('kitti_rpe'))[:160]}")
+PY
+  local data=()
+  [ -n "${SCANS:-}" ] && data=(--data "$SCANS")
+  "${farlio[@]}" bench --profile urban --scans "$FRAMES" "${data[@]}" --device cuda --no-kiss
+}
+if [ "${PYTHON:-0}" = 1 ]; then
+  use_debs
+  python3 -c "import sys, sysconfig, os; h = sysconfig.get_paths()['include']; print(sys.version.split()[0], h, 'Python.h:', os.path.exists(h + '/Python.h'))"
+  step "Python package on the GPU" python.log "$PYTHON_LIMIT_S" bash -c "$(declare -f python_check); \
+    CUDA_ARCH='$CUDA_ARCH' JOBS='$JOBS' FRAMES='$FRAMES' SCANS='${SCANS:-}' python_check" || status=1
 fi
 
 echo "== summary =="
