@@ -20,6 +20,8 @@ constexpr const char* kMapParameter = "cuda.max_map_voxels";
 constexpr const char* kFrameMapParameter = "cuda.max_frame_voxels";
 /// Bytes of each buffer of the copy ceiling: well beyond the L2 cache of any card.
 constexpr std::size_t kCopyBytes = std::size_t{256} << 20;
+/// Copies of a frame's inputs in the filled-GPU bandwidth samples.
+constexpr std::size_t kFilledCopies = 16;
 
 std::size_t checked_size(std::int64_t value, const char* name) {
   if (value <= 0) throw std::invalid_argument(std::string(name) + " must be > 0");
@@ -194,9 +196,31 @@ class CudaScanBackend final : public pipeline::ScanBackend {
     out.push_back(measure_knn(executor_, map_.view(), points.data(), gathered, config_.map.covariance_neighbors,
                               map::kUnboundedDistance2, repeats));
     const auto th = registration::Thresholds::from_sigma(config_.threshold.initial_threshold_m);
-    out.push_back(measure_gicp_reduction(
-        executor_, map_.view(), source_points_.data(), source_covs_.data(), source_size_,
-        static_cast<float>(th.max_correspondence_m * th.max_correspondence_m), last_pose_, repeats));
+    const auto max_d2 = static_cast<float>(th.max_correspondence_m * th.max_correspondence_m);
+    out.push_back(measure_gicp_reduction(executor_, map_.view(), source_points_.data(), source_covs_.data(),
+                                         source_size_, max_d2, last_pose_, repeats));
+    // the same kernels on kFilledCopies copies of their inputs: a launch that fills the GPU (one
+    // frame's 5-20k threads do not), to tell latency from bandwidth
+    const std::size_t copies = kFilledCopies;
+    const auto many_points = replicated(points.data(), gathered, copies);
+    out.push_back(measure_knn(executor_, map_.view(), many_points.data(), gathered * copies,
+                              config_.map.covariance_neighbors, map::kUnboundedDistance2, repeats));
+    const auto many_source = replicated(source_points_.data(), source_size_, copies);
+    const auto many_covs = replicated(source_covs_.data(), source_size_, copies);
+    out.push_back(measure_gicp_reduction(executor_, map_.view(), many_source.data(), many_covs.data(),
+                                         source_size_ * copies, max_d2, last_pose_, repeats));
+    for (std::size_t i = out.size() - 2; i < out.size(); ++i) out[i].kernel += " x" + std::to_string(copies);
+    return out;
+  }
+
+  /// `copies` copies of n device elements, one after the other.
+  template <typename T>
+  DeviceBuffer<T> replicated(const T* data, std::size_t n, std::size_t copies) {
+    DeviceBuffer<T> out(std::max<std::size_t>(n * copies, 1), "bandwidth inputs");
+    for (std::size_t c = 0; c < copies && n > 0; ++c) {
+      FARLIO_CUDA_CHECK(
+          cudaMemcpyAsync(out.data() + c * n, data, n * sizeof(T), cudaMemcpyDeviceToDevice, executor_.stream()));
+    }
     return out;
   }
 
