@@ -3,10 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "cuda_test_support.hpp"
 #include "farlio/pipeline/scan_pipeline.hpp"
 #include "farlio/sim/sequence_generator.hpp"
+#include "sim_recording.hpp"
 
 using namespace farlio;
 
@@ -105,4 +107,44 @@ TEST(CudaPipeline, FewFramesRunEveryKernel) {
     EXPECT_GT(r.map_insert.covariances_computed, 0u);
   }
   EXPECT_GT(gpu.backend().map_points(), 0u);
+}
+
+TEST(CudaPipeline, EmptyTinyAndNonFiniteScansGoAsOnTheCpu) {
+  // bad input on the device path: an empty scan, three points, and a scan with half its points
+  // NaN or infinite, among good scans; the same outcome as the CPU's, no device error
+  FARLIO_REQUIRE_GPU();
+  constexpr std::size_t kGood = 10, kEmpty = 3, kTiny = 5, kNonFinite = 7, kTinyPoints = 3;
+  constexpr double kMaxPoseDiff_m = 0.01;
+  sim::SimConfig sc = sim::default_config(sim::Profile::Urban);
+  sc.duration_s = 0.1 * static_cast<double>(kSkipAtRest + kGood + 1);
+  const sim::SequenceGenerator gen(sc);
+  pipeline::ScanPipeline cpu(config_on(Device::Cpu)), gpu(config_on(Device::Cuda));
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  for (std::size_t k = 0; k < kGood; ++k) {
+    Scan scan = gen.scan(kSkipAtRest + k);
+    if (k == kEmpty) {
+      scan.points.clear();
+      scan.time_s.clear();
+      scan.intensity.clear();
+      scan.sensor_id.clear();
+    } else if (k == kTiny) {
+      scan = test::thinned(scan, scan.size() / kTinyPoints);
+    } else if (k == kNonFinite) {
+      for (std::size_t i = 0; i < scan.size(); i += 2) scan.points[i] = Eigen::Vector3f(nan, 1.0f, inf);
+    }
+    const auto rc = cpu.process(scan);
+    const auto rg = gpu.process(scan);
+    SCOPED_TRACE("scan " + std::to_string(k));
+    const bool bad = k == kEmpty || k == kTiny;
+    EXPECT_EQ(rc.failure.empty(), !bad) << rc.failure;  // the CPU's verdict: what the GPU must match
+    if (k == kNonFinite) EXPECT_TRUE(rc.registered);    // half of it is a good scan
+    EXPECT_EQ(rc.registered, rg.registered);
+    EXPECT_EQ(rc.failure, rg.failure);
+    // libdevice's sin/cos in the undistortion may move a point into a neighbouring cell
+    EXPECT_NEAR(static_cast<double>(rg.kept_points), static_cast<double>(rc.kept_points), 0.01 * rc.kept_points);
+    EXPECT_TRUE(rg.pose.translation().allFinite());
+    EXPECT_LT((rc.pose.translation() - rg.pose.translation()).norm(), kMaxPoseDiff_m);
+  }
+  EXPECT_NEAR(static_cast<double>(gpu.backend().map_points()), static_cast<double>(cpu.backend().map_points()),
+              0.01 * static_cast<double>(cpu.backend().map_points()));
 }
