@@ -24,8 +24,8 @@
 
 namespace farlio::cuda {
 
-/// k nearest neighbours of several queries, k entries per query (tests and tools).
-/// k per query; the ranks past found[q] hold index -1 and a NaN distance.
+/// k nearest neighbours of several queries, k entries per query (tests and tools); the ranks
+/// past found[q] hold index -1 and a NaN distance.
 struct KnnResults {
   int k = 0;
   std::vector<int> found;
