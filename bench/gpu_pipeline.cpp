@@ -6,6 +6,7 @@
 // reduction against a device-to-device copy. Run by scripts/gpu_check.sh.
 // Usage: gpu_pipeline [--frames N] [--profile urban|racetrack|handheld|tunnel]... [--scans DIR]...
 //                     [--device cuda|cpu|auto] [--no-cpu-compare] [--repeats R]
+// --repeats R: launches timed per bandwidth sample (0: no bandwidth samples).
 // --scans DIR: every point cloud file of DIR (PCD, PLY, KITTI .bin, optionally .gz), in name
 // order, as scans 0.1 s apart without per-point times (KITTI's scans are already undistorted).
 #include <algorithm>
@@ -160,7 +161,7 @@ void print_row(const std::string& name, double points, Device device, const Run&
 
 void print_bandwidth(pipeline::ScanPipeline& p, int repeats, double frame_median_ms) {
 #ifdef FARLIO_WITH_CUDA
-  if (p.backend().device() != Device::Cuda) return;
+  if (p.backend().device() != Device::Cuda || repeats <= 0) return;
   const auto samples = cuda::measure_kernel_bandwidth(p.backend(), repeats);
   const double ceiling = samples.front().gb_per_s();
   std::printf("    %-22s %10s %12s %10s %10s\n", "kernel", "ms", "MB asked", "GB/s", "of copy");

@@ -8,7 +8,9 @@
 #      scan's upload, k-NN and reduction bandwidth against a device-to-device copy;
 #   4. run the GPU tests under compute-sanitizer memcheck, racecheck and initcheck (without the
 #      100-frame and odometry tests, whose kernels the short pipeline test runs too);
-#   5. with PYTHON=1: build the Python package there (pip, no index: the GPU image's own
+#   5. with NCU=1: Nsight Compute's duration of every kernel over 20 urban frames, summed per
+#      kernel and per frame (scripts/gpu_kernel_table.py), against the frame's wall time;
+#   6. with PYTHON=1: build the Python package there (pip, no index: the GPU image's own
 #      scikit-build-core, nanobind, numpy, matplotlib, PyYAML) and run the command line tool on the
 #      GPU: `farlio run --device cuda` and `--device cpu` on a generated 10 s urban sequence (their
 #      summaries side by side), then `farlio bench --device cuda` (and on SCANS).
@@ -18,7 +20,7 @@
 # sanitizers cannot pass for one with them.
 # Environment: BUILD (default build/gpu), CUDA_ARCH (default native), FRAMES (default 100),
 # JOBS (default nproc), SCANS (a folder of scans for the timing), SKIP_SANITIZERS=1,
-# PREBUILT (a folder made by --pack: run its binaries, build nothing), PYTHON=1.
+# PREBUILT (a folder made by --pack: run its binaries, build nothing), NCU=1, PYTHON=1.
 #
 #   scripts/gpu_check.sh --pack DIR   (on the build machine, after building BUILD with CUDA)
 # copies the two executables, stripped, and the shared libraries they need that are not the C
@@ -160,7 +162,22 @@ if [ "${SKIP_SANITIZERS:-0}" != 1 ]; then
   fi
 fi
 
-# The Python package and the command line tool on the GPU (step 5).
+# Where a frame's device time goes (step 5): every kernel's duration, replayed by ncu (its own
+# clocks left alone), over NCU_FRAMES urban frames without the bandwidth samples.
+NCU_FRAMES=${NCU_FRAMES:-20}
+if [ "${NCU:-0}" = 1 ]; then
+  NCU_BIN=$(command -v ncu || true)
+  if [ -z "$NCU_BIN" ]; then
+    summary+=("kernel profile (ncu)         NOT FOUND")
+  else
+    step "kernel profile (ncu)" ncu.log "$BENCH_LIMIT_S" bash -c "'$NCU_BIN' --clock-control none --metrics \
+      gpu__time_duration.sum --csv --page raw '$bin/gpu_pipeline' --frames $NCU_FRAMES --profile urban \
+      --no-cpu-compare --repeats 0 > '$LOGS/ncu.csv' && python3 scripts/gpu_kernel_table.py '$LOGS/ncu.csv' $NCU_FRAMES" ||
+      status=1
+  fi
+fi
+
+# The Python package and the command line tool on the GPU (step 6).
 python_check() {
   local site=/tmp/farlio-gpu-site seq=/tmp/farlio-gpu-seq runs=/tmp/farlio-gpu-runs
   rm -rf "$site" "$seq" "$runs"
