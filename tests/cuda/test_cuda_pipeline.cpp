@@ -137,7 +137,9 @@ TEST(CudaPipeline, EmptyTinyAndNonFiniteScansGoAsOnTheCpu) {
     SCOPED_TRACE("scan " + std::to_string(k));
     const bool bad = k == kEmpty || k == kTiny;
     EXPECT_EQ(rc.failure.empty(), !bad) << rc.failure;  // the CPU's verdict: what the GPU must match
-    if (k == kNonFinite) EXPECT_TRUE(rc.registered);    // half of it is a good scan
+    if (k == kNonFinite) {
+      EXPECT_TRUE(rc.registered);  // half of it is a good scan
+    }
     EXPECT_EQ(rc.registered, rg.registered);
     EXPECT_EQ(rc.failure, rg.failure);
     // libdevice's sin/cos in the undistortion may move a point into a neighbouring cell

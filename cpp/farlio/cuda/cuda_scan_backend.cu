@@ -22,6 +22,8 @@ constexpr const char* kFrameMapParameter = "cuda.max_frame_voxels";
 constexpr std::size_t kCopyBytes = std::size_t{256} << 20;
 /// Copies of a frame's inputs in the filled-GPU bandwidth samples.
 constexpr std::size_t kFilledCopies = 16;
+/// How far the undistortion may move a kept point: 100 m/s over a 0.1 s scan.
+constexpr double kUndistortionMargin_m = 10.0;
 
 std::size_t checked_size(std::int64_t value, const char* name) {
   if (value <= 0) throw std::invalid_argument(std::string(name) + " must be > 0");
@@ -91,7 +93,10 @@ class CudaScanBackend final : public pipeline::ScanBackend {
     std::uint64_t* keys = scratch_.keys.data();
     executor_.for_each(n, [=] __device__(std::size_t i) { keys[i] = pipeline::downsampling_key(raw[i], pp); });
     std::size_t valid = 0;
-    const std::size_t kept = sort_into_groups(scratch_, executor_, algorithms_, n, &valid);
+    // the crop keeps points within max_range_m of the sensor: their cells sort on short keys
+    const auto window = map::KeyWindow::around(Eigen::Vector3d::Zero(), config_.preprocess.max_range_m,
+                                               static_cast<double>(pp.inv_cell_m));
+    const std::size_t kept = sort_into_groups(scratch_, executor_, algorithms_, n, &valid, window);
     const std::int32_t* starts = scratch_.group_start.data();
     const std::int32_t* order = scratch_.sorted_order.data();
     Eigen::Vector3f* frame = frame_.data();
@@ -106,7 +111,7 @@ class CudaScanBackend final : public pipeline::ScanBackend {
     timer_.start(StageTimer::kSource);
     frame_map_.clear();
     frame_map_.insert(frame_.data(), frame_size_, Eigen::Vector3f::Zero(),
-                      map::PointLimit::constant(config_.density.frame_map_max_points_per_voxel));
+                      map::PointLimit::constant(config_.density.frame_map_max_points_per_voxel), points_within_m());
     source_size_ =
         frame_map_.gather(source_points_.data(), source_covs_.data(), source_points_.capacity(), kScanParameter);
     pipeline::SourceSummary out{source_size_,
@@ -150,7 +155,7 @@ class CudaScanBackend final : public pipeline::ScanBackend {
     const Eigen::Vector3f* frame = frame_.data();
     Eigen::Vector3f* world = world_.data();
     executor_.for_each(frame_size_, [=] __device__(std::size_t i) { world[i] = R * frame[i] + t; });
-    const map::InsertStats stats = map_.insert(world_.data(), frame_size_, t, limit);
+    const map::InsertStats stats = map_.insert(world_.data(), frame_size_, t, limit, points_within_m());
     *removed_voxels = map_.remove_far(t);
     last_pose_ = pose;
     timer_.stop(StageTimer::kMapUpdate);
@@ -185,6 +190,10 @@ class CudaScanBackend final : public pipeline::ScanBackend {
     timer_.read(t);
     return true;
   }
+
+  /// How far from the sensor a kept point may lie: the crop range, and the sensor's motion during
+  /// the scan that the undistortion adds (a farther point only costs a second sort).
+  [[nodiscard]] double points_within_m() const { return config_.preprocess.max_range_m + kUndistortionMargin_m; }
 
   std::vector<BandwidthSample> measure_bandwidth(int repeats) {
     std::vector<BandwidthSample> out{measure_copy(executor_, kCopyBytes, repeats)};

@@ -3,17 +3,21 @@
 #include <cub/device/device_scan.cuh>
 #include <cub/device/device_select.cuh>
 #include <limits>
+#include <stdexcept>
 
 #include "farlio/cuda/device_algorithms.hpp"
 
 namespace farlio::cuda {
 namespace {
 
-std::size_t sort_bytes(std::size_t n) {
+constexpr int kKeyBits = 8 * sizeof(std::uint64_t);
+
+std::size_t sort_bytes(std::size_t n, int key_bits = kKeyBits) {
   std::size_t bytes = 0;
-  FARLIO_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(
-      nullptr, bytes, static_cast<const std::uint64_t*>(nullptr), static_cast<std::uint64_t*>(nullptr),
-      static_cast<const std::int32_t*>(nullptr), static_cast<std::int32_t*>(nullptr), static_cast<int>(n)));
+  FARLIO_CUDA_CHECK(
+      cub::DeviceRadixSort::SortPairs(nullptr, bytes, static_cast<const std::uint64_t*>(nullptr),
+                                      static_cast<std::uint64_t*>(nullptr), static_cast<const std::int32_t*>(nullptr),
+                                      static_cast<std::int32_t*>(nullptr), static_cast<int>(n), 0, key_bits));
   return bytes;
 }
 
@@ -56,13 +60,13 @@ void DeviceAlgorithms::require(std::size_t n, std::size_t temp_bytes) const {
 }
 
 void DeviceAlgorithms::sort_pairs(const std::uint64_t* keys_in, std::uint64_t* keys_out, const std::int32_t* values_in,
-                                  std::int32_t* values_out, std::size_t n) {
+                                  std::int32_t* values_out, std::size_t n, int key_bits) {
   if (n == 0) return;
-  std::size_t bytes = sort_bytes(n);
+  if (key_bits <= 0 || key_bits > kKeyBits) throw std::invalid_argument("sort_pairs: key_bits must be in [1, 64]");
+  std::size_t bytes = sort_bytes(n, key_bits);
   require(n, bytes);
   FARLIO_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp_.data(), bytes, keys_in, keys_out, values_in, values_out,
-                                                    static_cast<int>(n), 0, static_cast<int>(8 * sizeof(std::uint64_t)),
-                                                    stream_));
+                                                    static_cast<int>(n), 0, key_bits, stream_));
 }
 
 std::size_t DeviceAlgorithms::select_flagged(const std::int32_t* in, const std::uint8_t* flags, std::int32_t* out,

@@ -16,9 +16,10 @@ class DeviceAlgorithms {
   /// Temporary storage for inputs of up to max_items items (< 2^31).
   DeviceAlgorithms(std::size_t max_items, cudaStream_t stream);
 
-  /// Sorts (key, value) pairs by key, stably: with values 0..n-1 the order is (key, index).
+  /// Sorts (key, value) pairs by key, stably: with values 0..n-1 the order is (key, index). Only
+  /// the low key_bits bits of the keys are compared (one radix pass per 8 bits or so).
   void sort_pairs(const std::uint64_t* keys_in, std::uint64_t* keys_out, const std::int32_t* values_in,
-                  std::int32_t* values_out, std::size_t n);
+                  std::int32_t* values_out, std::size_t n, int key_bits = 64);
   /// out[0, count) = the in[i] whose flags[i] != 0, in order; returns count (waits for it).
   std::size_t select_flagged(const std::int32_t* in, const std::uint8_t* flags, std::int32_t* out, std::size_t n);
   /// out[i] = in[0] + ... + in[i - 1], out[0] = 0.

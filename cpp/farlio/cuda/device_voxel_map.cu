@@ -122,7 +122,7 @@ void DeviceVoxelMap::rehash() {
 }
 
 map::InsertStats DeviceVoxelMap::insert(const Eigen::Vector3f* points, std::size_t n, const Eigen::Vector3f& origin,
-                                        const map::PointLimit& limit) {
+                                        const map::PointLimit& limit, double within_m) {
   map::InsertStats stats;
   stats.candidates = n;
   if (n == 0) return stats;
@@ -135,7 +135,8 @@ map::InsertStats DeviceVoxelMap::insert(const Eigen::Vector3f* points, std::size
   std::uint64_t* keys = s.keys.data();
   ex.for_each(n, [=] __device__(std::size_t i) { keys[i] = map::point_key(points[i], inv_voxel); });
   std::size_t valid = 0;
-  const std::size_t groups = sort_into_groups(s, ex, *algorithms_, n, &valid);
+  const auto window = map::KeyWindow::around(origin.cast<double>(), within_m, 1.0 / config_.voxel_size_m);
+  const std::size_t groups = sort_into_groups(s, ex, *algorithms_, n, &valid, window);
   stats.out_of_range = n - valid;
   if (groups == 0) return stats;
 

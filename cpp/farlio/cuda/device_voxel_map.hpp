@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -42,9 +43,11 @@ class DeviceVoxelMap {
   /// Takes new parameters (same max_points_per_voxel) and empties the map; allocates nothing.
   void reconfigure(const VoxelMapConfig& config);
   void clear();
-  /// Inserts n device points (world frame), as VoxelMap::insert.
+  /// Inserts n device points (world frame), as VoxelMap::insert. `within_m`: how far from origin
+  /// the points are expected (a scan's crop range): their voxels are then sorted on short keys
+  /// (map::KeyWindow); a point farther away costs a second sort, never a wrong result.
   map::InsertStats insert(const Eigen::Vector3f* points, std::size_t n, const Eigen::Vector3f& origin,
-                          const map::PointLimit& limit);
+                          const map::PointLimit& limit, double within_m = std::numeric_limits<double>::infinity());
   /// Removes voxels whose centre is farther than removal_radius_m from origin.
   std::size_t remove_far(const Eigen::Vector3f& origin);
   /// Mean points per voxel over voxels whose centre lies within range_m of origin (0: none).

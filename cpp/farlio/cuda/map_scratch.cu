@@ -15,6 +15,7 @@ MapScratch::MapScratch(std::size_t n, CudaExecutor& executor)
     : items(n),
       keys(n, "keys"),
       sorted_keys(n, "keys"),
+      short_keys(n, "keys"),
       iota(n, "keys"),
       sorted_order(n, "keys"),
       flags(n, "keys"),
@@ -26,36 +27,56 @@ MapScratch::MapScratch(std::size_t n, CudaExecutor& executor)
       group_stats(n, "keys"),
       scalars(kScalarCount, "scalars") {
   fill_iota(executor, iota.data(), n);
+  // every scalar defined from the start: sort_into_groups copies them back together
+  FARLIO_CUDA_CHECK(cudaMemsetAsync(scalars.data(), 0, scalars.bytes(), executor.stream()));
 }
 
 std::size_t MapScratch::memory_bytes() const {
-  return keys.bytes() + sorted_keys.bytes() + iota.bytes() + sorted_order.bytes() + flags.bytes() +
+  return keys.bytes() + sorted_keys.bytes() + short_keys.bytes() + iota.bytes() + sorted_order.bytes() + flags.bytes() +
          group_start.bytes() + group_voxel.bytes() + missing.bytes() + rank.bytes() + first_new.bytes() +
          group_stats.bytes() + scalars.bytes();
 }
 
-std::size_t sort_into_groups(MapScratch& s, CudaExecutor& ex, DeviceAlgorithms& alg, std::size_t n,
-                             std::size_t* valid) {
+std::size_t sort_into_groups(MapScratch& s, CudaExecutor& ex, DeviceAlgorithms& alg, std::size_t n, std::size_t* valid,
+                             const map::KeyWindow& window) {
   *valid = 0;
   if (n == 0) return 0;
   s.keys.require(n + 1, "cuda.max_scan_points");  // + 1: the end of the last group
-  alg.sort_pairs(s.keys.data(), s.sorted_keys.data(), s.iota.data(), s.sorted_order.data(), n);
-  const std::uint64_t* keys = s.sorted_keys.data();
-  std::uint8_t* flags = s.flags.data();
   std::int32_t* scalars = s.scalars.data();
+  const bool short_sort = window.usable();
+  if (short_sort) {
+    // the keys' short form in the window: the same order in fewer radix passes
+    FARLIO_CUDA_CHECK(cudaMemsetAsync(scalars + kScalarOutsideWindow, 0, sizeof(std::int32_t), ex.stream()));
+    const std::uint64_t* full = s.keys.data();
+    std::uint64_t* shorter = s.short_keys.data();
+    ex.for_each(n, [=] __device__(std::size_t i) {
+      bool outside = false;
+      shorter[i] = window.shorten(full[i], &outside);
+      if (outside) scalars[kScalarOutsideWindow] = 1;  // any writer: the same value
+    });
+    alg.sort_pairs(s.short_keys.data(), s.sorted_keys.data(), s.iota.data(), s.sorted_order.data(), n,
+                   window.total_bits());
+  } else {
+    alg.sort_pairs(s.keys.data(), s.sorted_keys.data(), s.iota.data(), s.sorted_order.data(), n);
+  }
+  std::uint64_t* keys = s.sorted_keys.data();
+  std::uint8_t* flags = s.flags.data();
+  const std::uint64_t empty_key = short_sort ? window.empty_short_key() : map::kEmptyKey;
   ex.for_each(n, [=] __device__(std::size_t i) {
     const std::uint64_t k = keys[i];
-    const bool empty = k == map::kEmptyKey;
+    const bool empty = k == empty_key;
     flags[i] = !empty && (i == 0 || k != keys[i - 1]);
     // exactly one thread writes where the valid keys end (empty keys sort last)
-    if (empty && (i == 0 || keys[i - 1] != map::kEmptyKey)) scalars[kScalarFirstEmpty] = static_cast<std::int32_t>(i);
+    if (empty && (i == 0 || keys[i - 1] != empty_key)) scalars[kScalarFirstEmpty] = static_cast<std::int32_t>(i);
     if (!empty && i == n - 1) scalars[kScalarFirstEmpty] = static_cast<std::int32_t>(n);
   });
+  if (short_sort) ex.for_each(n, [=] __device__(std::size_t i) { keys[i] = window.expand(keys[i]); });
   const std::size_t groups = alg.select_flagged(s.iota.data(), flags, s.group_start.data(), n);
-  std::int32_t first_empty = 0;
-  FARLIO_CUDA_CHECK(cudaMemcpyAsync(&first_empty, scalars + kScalarFirstEmpty, sizeof(first_empty),
-                                    cudaMemcpyDeviceToHost, ex.stream()));
+  std::int32_t found[kScalarCount] = {};
+  FARLIO_CUDA_CHECK(cudaMemcpyAsync(found, scalars, sizeof(found), cudaMemcpyDeviceToHost, ex.stream()));
   ex.synchronize();
+  if (short_sort && found[kScalarOutsideWindow] != 0) return sort_into_groups(s, ex, alg, n, valid);
+  const std::int32_t first_empty = found[kScalarFirstEmpty];
   *valid = static_cast<std::size_t>(first_empty);
   std::int32_t* starts = s.group_start.data();
   ex.for_each(1, [=] __device__(std::size_t) { starts[groups] = first_empty; });

@@ -8,6 +8,7 @@
 #include "farlio/cuda/cuda_executor.hpp"
 #include "farlio/cuda/device_algorithms.hpp"
 #include "farlio/cuda/device_buffer.hpp"
+#include "farlio/map/key_window.hpp"
 #include "farlio/map/voxel_update.hpp"
 
 namespace farlio::cuda {
@@ -17,6 +18,7 @@ struct MapScratch {
 
   std::size_t items;
   DeviceBuffer<std::uint64_t> keys, sorted_keys;
+  DeviceBuffer<std::uint64_t> short_keys;   ///< keys shortened to a KeyWindow (sort_into_groups)
   DeviceBuffer<std::int32_t> iota;          ///< 0, 1, 2, ... (filled once)
   DeviceBuffer<std::int32_t> sorted_order;  ///< input index of each sorted key
   DeviceBuffer<std::uint8_t> flags;
@@ -29,15 +31,18 @@ struct MapScratch {
 };
 
 /// Positions of scalars.
-inline constexpr int kScalarFirstEmpty = 0;  ///< sorted position of the first kEmptyKey (or n)
-inline constexpr int kScalarTableFull = 1;   ///< failed table insertions
-inline constexpr int kScalarCount = 2;
+inline constexpr int kScalarFirstEmpty = 0;     ///< sorted position of the first kEmptyKey (or n)
+inline constexpr int kScalarTableFull = 1;      ///< failed table insertions
+inline constexpr int kScalarOutsideWindow = 2;  ///< a key fell outside sort_into_groups' window
+inline constexpr int kScalarCount = 3;
 
 /// Sorts scratch.keys[0, n) with their indices (order: key, then index) and finds the groups of
 /// equal keys, kEmptyKey excluded: group g starts at sorted position group_start[g] and ends at
 /// group_start[g + 1] (written too). Returns the number of groups; *valid receives the number of
-/// keys that are not kEmptyKey.
+/// keys that are not kEmptyKey. With a usable `window` (the box the keys are expected in) the
+/// sort compares the keys' short form (map/key_window.hpp: fewer radix passes, the same order);
+/// if a key falls outside it, the keys are sorted again in full. sorted_keys holds full keys.
 std::size_t sort_into_groups(MapScratch& scratch, CudaExecutor& executor, DeviceAlgorithms& algorithms, std::size_t n,
-                             std::size_t* valid);
+                             std::size_t* valid, const map::KeyWindow& window = {});
 
 }  // namespace farlio::cuda
