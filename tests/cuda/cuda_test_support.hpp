@@ -2,6 +2,7 @@
 // What the GPU tests share: the skip without a device, and a device map beside a host map.
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -34,10 +35,11 @@ struct DeviceMapRig {
         map(config, voxel_capacity, "test voxel capacity", executor, algorithms, scratch),
         input(kMaxPoints, "test points") {}
 
+  /// `within_m`: how far from origin the points are said to lie (DeviceVoxelMap::insert).
   map::InsertStats insert(const std::vector<Eigen::Vector3f>& pts, const Eigen::Vector3f& origin,
-                          const map::PointLimit& limit) {
+                          const map::PointLimit& limit, double within_m = std::numeric_limits<double>::infinity()) {
     input.upload(pts.data(), pts.size(), executor.stream(), "DeviceMapRig::kMaxPoints");
-    return map.insert(input.data(), pts.size(), origin, limit);
+    return map.insert(input.data(), pts.size(), origin, limit, within_m);
   }
 };
 

@@ -143,3 +143,23 @@ TEST(CudaMap, LoadMapEqualsTheCpu) {
   pieces.backend().load_map(pts);
   expect_same_maps(cpu.backend().map_snapshot(), pieces.backend().map_snapshot(), false);
 }
+
+TEST(CudaMap, SortsOnShortKeysOrFallBackToTheFullKeysWithTheSameMap) {
+  // the voxel sort on short keys (points said to lie within a radius) and its fallback when some
+  // do not: the map must equal the CPU's either way
+  FARLIO_REQUIRE_GPU();
+  VoxelMapConfig cfg;
+  cfg.voxel_size_m = 1.0;
+  const auto pts = shifted(test::sample_scene(kScenePoints, 41, 0.02f), {-350.0f, 120.0f, -4.0f});
+  const Eigen::Vector3f origin(-340.0f, 125.0f, 0.0f);
+  exec::CpuExecutor ex(2);
+  map::VoxelMap cpu(cfg, ex);
+  cpu.insert(pts, origin, map::PointLimit::constant(20));
+  constexpr double kAllWithin_m = 500.0, kFewWithin_m = 3.0;
+  for (const double within_m : {kAllWithin_m, kFewWithin_m}) {
+    SCOPED_TRACE("within " + std::to_string(within_m) + " m");
+    test::DeviceMapRig gpu(cfg, kVoxelCapacity);
+    gpu.insert(pts, origin, map::PointLimit::constant(20), within_m);
+    expect_same_maps(cpu.snapshot(), gpu.map.snapshot());
+  }
+}
