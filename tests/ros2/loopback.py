@@ -27,11 +27,14 @@ def farlio_command(*args: str) -> list[str]:
     return [sys.executable, "-m", "farlio.cli", *args]
 
 
-def wait_for(condition: Callable[[], bool], timeout_s: float, what: str) -> None:
+def wait_for(condition: Callable[[], bool], timeout_s: float, what: str | Callable[[], str]) -> None:
+    """Polls condition until it holds; past timeout_s an AssertionError naming `what` (a callable:
+    its text at that moment, e.g. what had arrived)."""
     deadline = time.monotonic() + timeout_s
     while not condition():
         if time.monotonic() > deadline:
-            raise AssertionError(f"timed out after {timeout_s} s waiting for {what}")
+            described = what() if callable(what) else what
+            raise AssertionError(f"timed out after {timeout_s} s waiting for {described}")
         time.sleep(POLL_S)
 
 

@@ -34,7 +34,11 @@ def test_node_localizes_in_a_prior_map(urban, recorder, start_node, tmp_path):
     recorder.wait_for_node(node)
     play(path)
     n = len(ds)
-    wait_for(lambda: recorder.count("diagnostics") >= n, START_TIMEOUT_S, f"{n} scan diagnostics")
+    wait_for(
+        lambda: recorder.count("diagnostics") >= n,
+        START_TIMEOUT_S,
+        lambda: f"{n} scan diagnostics (received {recorder.count('diagnostics')}; node log: {node.text()[-3000:]})",
+    )
     assert node.stop() == 0
     log = node.text()
     assert "Traceback" not in log and "lost in the prior map" not in log, log
