@@ -38,6 +38,21 @@ def wait_for(condition: Callable[[], bool], timeout_s: float, what: str | Callab
         time.sleep(POLL_S)
 
 
+def wait_for_diagnostics(recorder: Recorder, n: int, node: NodeProcess, played: str = "") -> None:
+    """Waits for the node's first n scan diagnostics; on a timeout the error says how many came,
+    the last messages, the node's log and the player's output (to tell a scan the node dropped
+    from one that never reached it)."""
+
+    def described() -> str:
+        messages = [d["message"] for d in recorder.diagnostics()][-5:]
+        return (
+            f"{n} scan diagnostics (received {recorder.count('diagnostics')}, the last: {messages})\n"
+            f"node log:\n{node.text()[-3000:]}\nplayer output:\n{played[-2000:]}"
+        )
+
+    wait_for(lambda: recorder.count("diagnostics") >= n, START_TIMEOUT_S, described)
+
+
 class NodeProcess:
     """`farlio ros2 --ros-args [--params-file F] -p name:=value ...` in a subprocess, its output in
     `log`."""
@@ -137,7 +152,8 @@ class Recorder:
 
 
 def play(sequence: Path, *args: str) -> str:
-    """`farlio ros2-play sequence args...` at PLAY_RATE to its end; its output."""
+    """`farlio ros2-play sequence args...` at PLAY_RATE to its end; its output (stdout, then its
+    log on stderr)."""
     r = subprocess.run(
         farlio_command("ros2-play", str(sequence), "--rate", str(PLAY_RATE), *args),
         capture_output=True,
@@ -145,4 +161,4 @@ def play(sequence: Path, *args: str) -> str:
         timeout=PLAY_TIMEOUT_S,
     )
     assert r.returncode == 0, r.stdout + r.stderr
-    return r.stdout
+    return r.stdout + r.stderr

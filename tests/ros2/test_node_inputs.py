@@ -13,7 +13,7 @@ pytest.importorskip("rclpy")
 
 from farlio._core import NS_PER_S  # noqa: E402
 from farlio.datasets.pointcloud2_encode import encode  # noqa: E402
-from loopback import START_TIMEOUT_S, play, wait_for  # noqa: E402
+from loopback import START_TIMEOUT_S, play, wait_for, wait_for_diagnostics  # noqa: E402
 
 SCANS = 20
 #: between the hand-made clouds: longer than a scan takes
@@ -31,8 +31,8 @@ def run_node(urban, recorder, start_node, *params: str, play_args: tuple[str, ..
     path, _ = urban
     node = start_node(f"calib_file:={path / 'calib.yaml'}", *params)
     recorder.wait_for_node(node)
-    play(path, "--max-scans", str(SCANS), *play_args)
-    wait_for(lambda: recorder.count("diagnostics") >= SCANS, START_TIMEOUT_S, f"{SCANS} scan diagnostics")
+    played = play(path, "--max-scans", str(SCANS), *play_args)
+    wait_for_diagnostics(recorder, SCANS, node, played)
     assert node.stop() == 0
     return recorder.diagnostics()
 

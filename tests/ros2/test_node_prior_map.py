@@ -14,7 +14,7 @@ from farlio import _core  # noqa: E402
 from farlio._core import NS_PER_S  # noqa: E402
 from farlio.mapping import MAP_PCD, MapOptions  # noqa: E402
 from farlio.runner import SCANS_BODY_TUM, run_dataset  # noqa: E402
-from loopback import START_TIMEOUT_S, play, wait_for  # noqa: E402
+from loopback import play, wait_for_diagnostics  # noqa: E402
 
 #: the scan odometry against the mapping run's pose at the same stamp (the map's frame)
 MAX_ERROR_M = 0.05
@@ -32,13 +32,9 @@ def test_node_localizes_in_a_prior_map(urban, recorder, start_node, tmp_path):
         "initial_pose:=[0.3,-0.2,0.0,0.0,0.0,1.0]",
     )
     recorder.wait_for_node(node)
-    play(path)
+    played = play(path)
     n = len(ds)
-    wait_for(
-        lambda: recorder.count("diagnostics") >= n,
-        START_TIMEOUT_S,
-        lambda: f"{n} scan diagnostics (received {recorder.count('diagnostics')}; node log: {node.text()[-3000:]})",
-    )
+    wait_for_diagnostics(recorder, n, node, played)
     assert node.stop() == 0
     log = node.text()
     assert "Traceback" not in log and "lost in the prior map" not in log, log

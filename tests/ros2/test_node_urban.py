@@ -18,7 +18,7 @@ from farlio._core import NS_PER_S  # noqa: E402
 from farlio.datasets.calib import se3_from_quaternion  # noqa: E402
 from farlio.evaluation import evaluate_files  # noqa: E402
 from farlio.runner import ODOMETRY_TUM, run_dataset  # noqa: E402
-from loopback import START_TIMEOUT_S, play, wait_for  # noqa: E402
+from loopback import play, wait_for_diagnostics  # noqa: E402
 
 #: the live odometry may be this much worse than the replay of `farlio run` (issue 12)
 ACCURACY_FACTOR = 1.5
@@ -42,9 +42,9 @@ def test_urban_over_loopback_matches_farlio_run(urban, recorder, start_node, tmp
     params_file = Path(farlio.__file__).parent / "ros2" / "share" / "params.yaml"
     node = start_node(f"calib_file:={path / 'calib.yaml'}", f"map_file:={map_file}", params_file=params_file)
     recorder.wait_for_node(node)
-    play(path)
+    played = play(path)
     n = len(ds)
-    wait_for(lambda: recorder.count("diagnostics") >= n, START_TIMEOUT_S, f"{n} scan diagnostics")
+    wait_for_diagnostics(recorder, n, node, played)
 
     response = recorder.save_map()
     assert response.success, response.message
