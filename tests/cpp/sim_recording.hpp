@@ -66,6 +66,14 @@ inline Recording record(sim::Profile profile, double duration_s, std::size_t kee
   return r;
 }
 
+/// How far a run's body position at the last scan is from the truth, both taken relative to the
+/// first scan (the run's own start and the recording's): the end drift of the motion estimated.
+inline double final_position_error_m(const Recording& rec, const SE3& first_body, const SE3& last_body) {
+  const SE3 truth = rec.body_at_scan_end.front().inverse() * rec.body_at_scan_end.back();
+  const SE3 estimate = first_body.inverse() * last_body;
+  return (truth.translation() - estimate.translation()).norm();
+}
+
 /// Results that do not depend on how fast this machine is: no registration time budget (a slow
 /// sanitizer build would otherwise drop frames the replay keeps, or the other way round).
 inline Config deterministic_config() {

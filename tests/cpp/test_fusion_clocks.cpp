@@ -76,10 +76,7 @@ ReplayRun replay(const Recording& rec, std::vector<ImuSample> imu, const std::ve
 }
 
 double final_position_error_m(const Recording& rec, const ReplayRun& run) {
-  // both start at the first scan's pose: compare the motion since then
-  const SE3 truth = rec.body_at_scan_end.front().inverse() * rec.body_at_scan_end.back();
-  const SE3 estimate = run.frames.front().body_pose.inverse() * run.frames.back().body_pose;
-  return (truth.translation() - estimate.translation()).norm();
+  return test::final_position_error_m(rec, run.frames.front().body_pose, run.frames.back().body_pose);
 }
 
 /// Pushes the IMU and the scans of `rec` to an online odometry in stamp order, scan by scan

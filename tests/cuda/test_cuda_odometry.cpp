@@ -48,11 +48,6 @@ ReplayRun replay(const test::Recording& rec, Device device) {
   return r;
 }
 
-double final_error_m(const test::Recording& rec, const ReplayRun& run) {
-  const SE3 truth = rec.body_at_scan_end.front().inverse() * rec.body_at_scan_end.back();
-  return (truth.translation() - run.poses.back().translation()).norm();
-}
-
 void expect_gpu_tracks_as_the_cpu(sim::Profile profile) {
   const test::Recording rec = test::record(profile, kDuration_s, kAllPoints);
   const ReplayRun cpu = replay(rec, Device::Cpu);
@@ -64,7 +59,9 @@ void expect_gpu_tracks_as_the_cpu(sim::Profile profile) {
     worst_t = std::max(worst_t, d.translation().norm());
     worst_r = std::max(worst_r, d.angle_rad() * 180.0 / M_PI);
   }
-  const double cpu_error = final_error_m(rec, cpu), gpu_error = final_error_m(rec, gpu);
+  // the runs' poses are already relative to their first scan
+  const double cpu_error = test::final_position_error_m(rec, SE3(), cpu.poses.back());
+  const double gpu_error = test::final_position_error_m(rec, SE3(), gpu.poses.back());
   std::printf(
       "%s LIO, %zu scans: GPU vs CPU poses within %.2e m, %.2e deg; final position error CPU %.3f m, "
       "GPU %.3f m; fused CPU %zu, GPU %zu\n",
