@@ -153,12 +153,18 @@ class Recorder:
 
 def play(sequence: Path, *args: str) -> str:
     """`farlio ros2-play sequence args...` at PLAY_RATE to its end; its output (stdout, then its
-    log on stderr)."""
+    log on stderr). The player waits up to START_TIMEOUT_S for the node's subscriptions: with its
+    default wait a loaded machine had it play before discovery was done, and the first scans were
+    lost (the suite's occasional timeouts waiting for diagnostics)."""
     r = subprocess.run(
-        farlio_command("ros2-play", str(sequence), "--rate", str(PLAY_RATE), *args),
+        farlio_command(
+            "ros2-play", str(sequence), "--rate", str(PLAY_RATE), "--wait-subscribers", str(START_TIMEOUT_S), *args
+        ),
         capture_output=True,
         text=True,
-        timeout=PLAY_TIMEOUT_S,
+        timeout=PLAY_TIMEOUT_S + START_TIMEOUT_S,
     )
-    assert r.returncode == 0, r.stdout + r.stderr
-    return r.stdout + r.stderr
+    out = r.stdout + r.stderr
+    assert r.returncode == 0, out
+    assert "playing anyway" not in out, f"the player did not discover the node's subscriptions:\n{out}"
+    return out

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from farlio.datasets import FORMAT_HELP, FORMATS, LoadOptions, open_dataset
 from farlio.datasets.pointcloud2_encode import CONVENTIONS
-from farlio.ros2 import add_transport_argument, choose_transport, require_rclpy
+from farlio.ros2 import WAIT_SUBSCRIBERS_S, add_transport_argument, choose_transport, require_rclpy
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -43,9 +43,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--wait-subscribers",
         type=float,
-        default=3.0,
+        default=WAIT_SUBSCRIBERS_S,
         metavar="S",
-        help="wait up to S seconds for a subscriber on every topic before playing",
+        help="wait up to S seconds for a subscriber on every topic before playing (what is published "
+        "before a subscriber is discovered is lost to it; 0: do not wait)",
     )
     parser.add_argument("--max-scans", type=int, default=None, help="stop after this many scans")
     parser.add_argument("--clock", action="store_true", help="also publish /clock at the IMU stamps (use_sim_time)")

@@ -14,6 +14,10 @@ from pathlib import Path
 INSTALL_HINT = (
     "rclpy is missing: the ROS 2 wheels live in .venv-ros (scripts/install_ros2.sh): use .venv-ros/bin/farlio"
 )
+#: how long `farlio ros2-play` waits for a subscriber on every topic by default: Fast DDS announces
+#: a participant a few times at its start and then every 3 s, so a missed first announcement (a
+#: loaded machine) costs one period or more
+WAIT_SUBSCRIBERS_S = 10.0
 
 
 def require_rclpy() -> None:

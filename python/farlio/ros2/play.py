@@ -27,6 +27,7 @@ from farlio._core import NS_PER_S
 
 from ..datasets import Dataset
 from ..datasets.pointcloud2_encode import encode
+from . import WAIT_SUBSCRIBERS_S
 from . import conversions as conv
 
 PLAYER_NODE = "farlio_play"
@@ -47,7 +48,7 @@ class PlayOptions:
     convention: str = "ouster"  # per-point time convention (farlio.datasets.pointcloud2_encode)
     rate: float = 1.0  # times real time
     lidar_time_shift_s: float = 0.0  # added to the LiDAR stamps (a LiDAR clock off the IMU's)
-    wait_subscribers_s: float = 3.0  # wait up to this for a subscriber on every topic
+    wait_subscribers_s: float = WAIT_SUBSCRIBERS_S  # wait up to this for a subscriber on every topic
     max_scans: int | None = None
     clock: bool = False  # also publish /clock (for use_sim_time)
 
@@ -183,7 +184,8 @@ def play(dataset: Dataset, options: PlayOptions, ros_args: list[str] | None = No
         player = Player(node, dataset, options)
         if options.wait_subscribers_s > 0 and not player.wait_for_subscribers():
             node.get_logger().warning(
-                f"no subscriber on every topic after {options.wait_subscribers_s} s: playing anyway"
+                f"no subscriber on every topic after {options.wait_subscribers_s} s: playing anyway "
+                "(messages before the subscribers are discovered are lost)"
             )
         return player.play()
     finally:
