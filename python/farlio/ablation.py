@@ -7,6 +7,7 @@ import csv
 from pathlib import Path
 from typing import Any
 
+from ._core import Config
 from .config import load_config
 from .datasets import open_dataset
 from .runner import replay_options, run_dataset
@@ -76,16 +77,22 @@ def ablate(sequence: Path, out_dir: Path, *, latency: str = "measured", max_fram
 
 
 def latency_sweep(
-    sequence: Path, out_dir: Path, delays_s: list[float], *, max_frames: int | None = None, plot: bool = True
+    sequence: Path,
+    out_dir: Path,
+    delays_s: list[float],
+    *,
+    max_frames: int | None = None,
+    plot: bool = True,
+    config: Config | None = None,
 ) -> list[dict]:
-    """Runs the LIO with each added delay on top of the measured latency; writes latency_sweep.csv,
-    latency_sweep.md and (plot) latency_sweep.png into out_dir."""
+    """Runs the LIO (config, default: the defaults) with each added delay on top of the measured
+    latency; writes latency_sweep.csv, latency_sweep.md and (plot) latency_sweep.png into out_dir."""
     rows = []
     for d in delays_s:
         s = run_dataset(
             open_dataset(sequence),
             out_dir / f"delay_{d * 1e3:.0f}ms",
-            load_config(None),
+            config if config is not None else load_config(None),
             progress=False,
             plot=False,
             options=replay_options("measured", 0.0, d),

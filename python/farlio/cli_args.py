@@ -1,4 +1,4 @@
-"""Argument types of the command line: numbers that must lie in a range.
+"""Arguments shared by the commands: numbers that must lie in a range, and the config fields.
 
 argparse reports a value they refuse as ``farlio <command>: error: argument --max-frames: must be
 an integer >= 1, got -1`` with exit status 2, before any work starts.
@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import math
 from collections.abc import Callable
+from pathlib import Path
 
 
 def _number(kind: type, text: str) -> float | int:
@@ -47,3 +48,17 @@ positive_float = _bounded(float, 0.0, inclusive=False)
 non_negative_float = _bounded(float, 0.0)
 #: a chance in [0, 1]
 probability = _bounded(float, 0.0, high=1.0)
+
+
+def add_config_arguments(parser: argparse.ArgumentParser) -> None:
+    """--config YAML and --set KEY=VALUE (repeatable): the config fields a command runs with
+    (farlio.config.load_config(args.config, args.overrides))."""
+    parser.add_argument("--config", type=Path, default=None, help="YAML file overriding config fields")
+    parser.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="override one config field, e.g. --set map.voxel_size_m=2 (repeatable)",
+    )

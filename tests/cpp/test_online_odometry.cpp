@@ -3,6 +3,7 @@
 // keep its outputs consistent (every scan reported once, a regular 10 ms odometry).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -234,4 +235,106 @@ TEST(Odometry, AZeroFusionStepIsAnErrorNamingTheField) {
       EXPECT_NE(std::string(e.what()).find("fusion.step_s"), std::string::npos) << e.what();
     }
   }
+}
+
+namespace {
+
+/// The frames of rec's first scans handed to an OnlineOdometry whose worker is held in its
+/// on_frame of the first scan while the others arrive: (processed?) per scan stamp, in order.
+std::vector<std::pair<std::int64_t, bool>> scans_into_a_held_worker(bool wait_when_busy, std::size_t n,
+                                                                    std::vector<bool>* accepted) {
+  const Recording& rec = recording();
+  Config config = deterministic_config();
+  config.registration.wait_when_busy = wait_when_busy;
+  std::mutex m;
+  std::condition_variable cv;
+  bool first_done = false, release = false;
+  std::vector<std::pair<std::int64_t, bool>> frames;
+  OnlineOdometry online(config, rec.T_imu_lidar, rec.gravity_m_s2, {}, [&](const OdometryFrame& f) {
+    std::unique_lock lock(m);
+    frames.emplace_back(f.scan.stamp_ns, f.processed);
+    if (frames.size() == 1) {  // the worker, after the first scan: busy until released
+      first_done = true;
+      cv.notify_all();
+      cv.wait(lock, [&] { return release; });
+    }
+  });
+  accepted->push_back(online.add_scan(rec.scans[0]));
+  {
+    std::unique_lock lock(m);
+    cv.wait(lock, [&] { return first_done; });
+  }
+  for (std::size_t i = 1; i < n; ++i) accepted->push_back(online.add_scan(rec.scans[i]));
+  {
+    std::lock_guard lock(m);
+    release = true;
+  }
+  cv.notify_all();
+  online.wait_idle();
+  online.stop();
+  std::sort(frames.begin(), frames.end());
+  return frames;
+}
+
+}  // namespace
+
+TEST(OnlineOdometry, AScanArrivingWhileBusyWaitsAndTheNewestOfABurstWins) {
+  const Recording& rec = recording();
+  const auto stamp = [&](std::size_t i) { return rec.scans[i].end_stamp_ns; };
+  // a burst of three scans while the worker is busy: the last one waits, the two before it are
+  // dropped as busy (each replaced by a newer one), none is lost without a frame
+  std::vector<bool> accepted;
+  auto frames = scans_into_a_held_worker(true, 4, &accepted);
+  EXPECT_EQ(accepted, (std::vector<bool>{true, true, true, true}));
+  const std::vector<std::pair<std::int64_t, bool>> waited = {
+      {stamp(0), true}, {stamp(1), false}, {stamp(2), false}, {stamp(3), true}};
+  EXPECT_EQ(frames, waited);
+  // the paper's rule: every scan arriving while busy is dropped at once
+  accepted.clear();
+  frames = scans_into_a_held_worker(false, 4, &accepted);
+  EXPECT_EQ(accepted, (std::vector<bool>{true, false, false, false}));
+  const std::vector<std::pair<std::int64_t, bool>> dropped = {
+      {stamp(0), true}, {stamp(1), false}, {stamp(2), false}, {stamp(3), false}};
+  EXPECT_EQ(frames, dropped);
+}
+
+TEST(Replay, AScanArrivingWhileBusyWaitsUnlessTheNextArrivesFirst) {
+  // a fixed latency of 1.45 scan periods (no tie between an arrival and the pipeline's end): with
+  // waiting, a scan that arrives while the pipeline is busy starts when it is free, unless the next
+  // scan arrives before that (then it is dropped); without, every scan arriving while busy is dropped
+  const Recording& rec = recording();
+  const std::int64_t period_ns = rec.scans[1].end_stamp_ns - rec.scans[0].end_stamp_ns;
+  ReplayOptions slow;
+  slow.latency = LatencyModel::Fixed;
+  slow.fixed_latency_s = 1.45 * static_cast<double>(period_ns) * 1e-9;
+  std::size_t processed_waiting = 0, processed_dropping = 0;
+  for (const bool wait : {true, false}) {
+    Config config = deterministic_config();
+    config.registration.wait_when_busy = wait;
+    Odometry replay(config, rec.T_imu_lidar, rec.gravity_m_s2, rec.imu, slow);
+    std::int64_t free_ns = 0;  // when the pipeline finishes the last processed scan
+    for (std::size_t i = 0; i < rec.scans.size(); ++i) {
+      const Scan& s = rec.scans[i];
+      const OdometryFrame f = replay.process(s);
+      const bool busy = s.end_stamp_ns < free_ns;
+      const bool next_first = free_ns > s.end_stamp_ns + period_ns;
+      SCOPED_TRACE(testing::Message() << "wait " << wait << " scan " << i);
+      if (!busy) {
+        EXPECT_TRUE(f.processed);
+        EXPECT_EQ(f.started_ns, s.end_stamp_ns);
+      } else if (wait && !next_first) {
+        EXPECT_TRUE(f.processed);
+        EXPECT_EQ(f.started_ns, free_ns);  // it waited for the pipeline, at most one period
+        EXPECT_LE(f.started_ns - s.end_stamp_ns, period_ns);
+      } else {
+        EXPECT_FALSE(f.processed);
+        EXPECT_NE(f.drop_reason.find("still busy"), std::string::npos) << f.drop_reason;
+      }
+      if (f.processed) free_ns = f.available_ns;
+      (wait ? processed_waiting : processed_dropping) += f.processed ? 1 : 0;
+    }
+  }
+  // 1.45 periods: the paper's rule processes every other scan, waiting two of every three
+  EXPECT_LE(processed_dropping, (rec.scans.size() + 1) / 2);
+  EXPECT_GE(processed_waiting, 2 * rec.scans.size() / 3);
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <utility>
 
 #include "farlio/core/clock_check.hpp"
 #include "farlio/core/error.hpp"
@@ -48,6 +49,7 @@ void validate_replay_options(const ReplayOptions& options) {
 Odometry::Odometry(const Config& config, const SE3& T_imu_lidar, double gravity_m_s2, std::vector<ImuSample> imu,
                    const ReplayOptions& options)
     : options_(options),
+      wait_when_busy_(config.registration.wait_when_busy),
       T_imu_lidar_(T_imu_lidar),
       T_lidar_imu_(T_imu_lidar.inverse()),
       imu_(std::move(imu)),
@@ -108,8 +110,16 @@ double Odometry::latency_s(const FrameResult& r) const {
   return base + options_.added_delay_s;
 }
 
+bool Odometry::dropped_as_busy(const Scan& scan, std::int64_t previous_end_ns) const {
+  if (scan.end_stamp_ns >= busy_until_ns_) return false;  // the pipeline is free when it arrives
+  // it waits unless the next scan, one period later, arrives while the pipeline is still busy
+  const std::int64_t next_arrival_ns = scan.end_stamp_ns + (scan.end_stamp_ns - previous_end_ns);
+  return !wait_when_busy_ || busy_until_ns_ > next_arrival_ns;
+}
+
 OdometryFrame Odometry::process(const Scan& scan) {
-  if (scan.end_stamp_ns < busy_until_ns_) return busy_frame(scan);
+  const std::int64_t previous_end_ns = std::exchange(last_scan_end_ns_, scan.end_stamp_ns);
+  if (dropped_as_busy(scan, previous_end_ns)) return busy_frame(scan);
   if (!clock_started_ && driver_.inertial()) {
     // the clock starts at the first IMU sample, so the fusion sees every sample before the
     // first scan on its grid (as the online odometry does), or at a first scan before the IMU
@@ -121,7 +131,7 @@ OdometryFrame Odometry::process(const Scan& scan) {
     clock_ns_ = std::min(imu_.front().stamp_ns, scan.end_stamp_ns);
   }
   OdometryFrame out;
-  out.started_ns = std::max(scan.end_stamp_ns, clock_ns_);
+  out.started_ns = std::max(scan.end_stamp_ns, clock_ns_);  // later when it waited for the pipeline
   advance_clock(out.started_ns);
   if (pipeline_.frames() == 0 && (driver_.inertial() || requested_initial_pose_)) {
     // roll and pitch from the IMU seen so far; position and yaw as requested

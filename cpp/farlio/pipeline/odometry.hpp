@@ -9,8 +9,10 @@
 //   its result becomes available after the latency (measured processing time, zero, a fixed
 //   value, plus an optional added delay) and is fused as a delayed measurement;
 //   the fusion's output at every 10 ms step is the odometry.
-// A scan that arrives while the pipeline is still busy, or whose registration ran out of its
-// time budget, is dropped (as in the paper). Without IMU samples, or with fusion.enabled off,
+// A scan that arrives while the pipeline is still busy waits for it, as in the online odometry
+// (registration.wait_when_busy), unless the next scan (one period later) would arrive first: then
+// it is dropped, as it always is with wait_when_busy off (the paper). A scan whose registration
+// ran out of its time budget is dropped. Without IMU samples, or with fusion.enabled off,
 // the scan pipeline runs alone on its constant-velocity model (LiDAR-only odometry).
 // The clock starts at the first IMU sample, or at the first scan when that ends earlier: scans
 // before the IMU starts run LiDAR-only (as in the online odometry), the fusion takes over from
@@ -77,8 +79,11 @@ class Odometry {
  private:
   void advance_clock(std::int64_t stamp_ns);
   [[nodiscard]] double latency_s(const FrameResult& r) const;
+  /// Whether the scan arrives (at its end stamp) while the pipeline is busy and does not wait.
+  [[nodiscard]] bool dropped_as_busy(const Scan& scan, std::int64_t previous_end_ns) const;
 
   ReplayOptions options_;
+  bool wait_when_busy_;
   SE3 T_imu_lidar_, T_lidar_imu_;
   SE3 initial_body_pose_;
   std::optional<SE3> requested_initial_pose_;  ///< set_initial_pose
@@ -89,6 +94,7 @@ class Odometry {
   bool clock_started_ = false;
   std::int64_t clock_ns_ = 0;
   std::int64_t busy_until_ns_ = 0;
+  std::int64_t last_scan_end_ns_ = 0;  ///< of the previous scan handed to process()
   std::vector<std::string> warnings_;
   FusionDriver::Samples outputs_;  ///< reused buffer of the odometry samples of one clock advance
 };

@@ -44,21 +44,25 @@ void OnlineOdometry::add_imu(const ImuSample& sample) {
 }
 
 bool OnlineOdometry::add_scan(Scan scan) {
+  bool accepted = false;
+  std::optional<Scan> replaced;  // the scan that waited, when this newer one takes its place
   {
     std::lock_guard lock(queue_mutex_);
-    if (!busy_ && !pending_ && !stopping_) {
+    if (!stopping_ && (!busy_ || config_.registration.wait_when_busy)) {
+      if (pending_) replaced = std::move(pending_);
       pending_ = std::move(scan);
       busy_ = true;
-      queue_cv_.notify_all();
-      return true;
+      accepted = true;
     }
   }
+  if (accepted) queue_cv_.notify_all();
+  if (accepted && !replaced) return true;
   {
     std::lock_guard lock(state_mutex_);
     ++dropped_busy_;
   }
-  if (on_frame_) on_frame_(busy_frame(scan));
-  return false;
+  if (on_frame_) on_frame_(busy_frame(replaced ? *replaced : scan));
+  return accepted;
 }
 
 void OnlineOdometry::wait_idle() {
@@ -80,7 +84,7 @@ void OnlineOdometry::worker_loop() {
     if (on_frame_) on_frame_(frame);
     {
       std::lock_guard lock(queue_mutex_);
-      busy_ = false;
+      busy_ = pending_.has_value();  // a scan that waited is next
     }
     queue_cv_.notify_all();
   }

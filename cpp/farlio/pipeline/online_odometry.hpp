@@ -8,7 +8,10 @@
 // Threads: add_imu() and add_scan() may be called from any threads (each kind in time order).
 // on_odometry runs on the thread that called add_imu(); on_frame runs on the worker (or on the
 // add_scan() caller for a dropped scan). Callbacks must not call back into the object.
-// A scan that arrives while the worker is still busy is dropped (as in the paper). With
+// A scan that arrives while the worker is still busy waits in a slot of one
+// (registration.wait_when_busy): a newer scan arriving before the worker is free takes its place
+// and the older is dropped, so a burst from the transport loses no scan and a scan waits at most
+// one frame; with wait_when_busy off it is dropped at once (as in the paper). With
 // fusion.enabled off, or until the first IMU sample arrives, the odometry is LiDAR-only and
 // on_odometry is not called; the fusion takes over with the first scan after the first IMU
 // sample (scans before it are registered, not fused; the world frame is then not gravity
@@ -54,11 +57,14 @@ class OnlineOdometry {
 
   /// Feeds the fusion and emits the odometry for every 10 ms step up to the sample's stamp.
   void add_imu(const ImuSample& sample);
-  /// Hands the scan to the worker; false (and on_frame with the reason) when it is busy.
+  /// Hands the scan to the worker (to wait for it when it is busy); false (and on_frame with the
+  /// reason) when it is dropped. A scan that was waiting and is replaced gets on_frame with the
+  /// reason here too.
   bool add_scan(Scan scan);
-  /// Blocks until the worker has finished every scan handed to it.
+  /// Blocks until the worker has finished every scan handed to it (the waiting one included).
   void wait_idle();
-  /// Finishes the scan in progress, then ends the worker (also done by the destructor).
+  /// Finishes the scan in progress and the one waiting, then ends the worker (also done by the
+  /// destructor).
   void stop();
 
   /// Whether the fusion is in use: enabled, IMU samples have arrived, and the IMU was not found
@@ -67,7 +73,7 @@ class OnlineOdometry {
   /// The warnings since the last call (a reset of the fusion, the gyro's unit, an unusable IMU).
   [[nodiscard]] std::vector<std::string> take_warnings();
   [[nodiscard]] std::optional<fusion::FusionStats> fusion_stats() const;
-  /// Scans dropped because the worker was busy.
+  /// Scans dropped because the worker was busy (at once, or replaced while waiting).
   [[nodiscard]] std::size_t scans_dropped_busy() const;
   /// The backend the scan pipeline runs on (chosen at construction) and why auto fell back to the
   /// CPU ('' when it did not).
@@ -101,11 +107,11 @@ class OnlineOdometry {
   // worker, guarded by queue_mutex_
   std::mutex queue_mutex_;
   std::condition_variable queue_cv_;
-  std::optional<Scan> pending_;
-  bool busy_ = false, stopping_ = false;
-  mutable std::mutex pipeline_mutex_;  // held by the worker while it processes, and by map_snapshot
-  ScanPipeline pipeline_;              // its backend made at construction; the start pose set at the first scan
-  std::thread worker_;                 // last: started when everything above is constructed
+  std::optional<Scan> pending_;           ///< the scan the worker takes next
+  bool busy_ = false, stopping_ = false;  ///< busy: a scan is processed or waiting
+  mutable std::mutex pipeline_mutex_;     // held by the worker while it processes, and by map_snapshot
+  ScanPipeline pipeline_;                 // its backend made at construction; the start pose set at the first scan
+  std::thread worker_;                    // last: started when everything above is constructed
 };
 
 }  // namespace farlio::pipeline

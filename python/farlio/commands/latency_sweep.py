@@ -6,7 +6,8 @@ import argparse
 from pathlib import Path
 
 from farlio.ablation import latency_sweep
-from farlio.cli_args import non_negative_float, positive_int
+from farlio.cli_args import add_config_arguments, non_negative_float, positive_int
+from farlio.config import load_config
 
 DEFAULT_DELAYS_MS = [0, 20, 40, 60, 80, 100, 150, 200, 300]
 
@@ -23,11 +24,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--max-frames", type=positive_int, default=None, help="stop each run after this many scans")
     parser.add_argument("--no-plot", action="store_true", help="no latency_sweep.png")
+    add_config_arguments(parser)
 
 
 def run(args: argparse.Namespace) -> int:
     rows = latency_sweep(
-        args.path, args.out, [d / 1e3 for d in args.delays_ms], max_frames=args.max_frames, plot=not args.no_plot
+        args.path,
+        args.out,
+        [d / 1e3 for d in args.delays_ms],
+        max_frames=args.max_frames,
+        plot=not args.no_plot,
+        config=load_config(args.config, args.overrides),
     )
     for r in rows:
         print(

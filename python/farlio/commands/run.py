@@ -6,7 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from farlio.cli_args import non_negative_float, non_negative_int, positive_float, positive_int
+from farlio.cli_args import add_config_arguments, non_negative_float, non_negative_int, positive_float, positive_int
 from farlio.config import load_config
 from farlio.datasets import FORMAT_HELP, FORMATS, LoadOptions, TimeOptions, open_dataset
 from farlio.datasets.pointcloud2 import HEADER_STAMPS, TIME_FIELDS, TIME_UNITS
@@ -18,15 +18,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("path", type=Path, help=f"the recording, its format detected from the path: {FORMAT_HELP}")
     parser.add_argument("--out", type=Path, required=True, help="output folder (created)")
     parser.add_argument("--format", default="auto", choices=["auto", *FORMATS], help="input format")
-    parser.add_argument("--config", type=Path, default=None, help="YAML file overriding config fields")
-    parser.add_argument(
-        "--set",
-        dest="overrides",
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help="override one config field, e.g. --set map.voxel_size_m=2 (repeatable)",
-    )
+    add_config_arguments(parser)
     parser.add_argument(
         "--threads", type=non_negative_int, default=None, help="CPU threads (default: all; = num_threads)"
     )
