@@ -444,10 +444,10 @@ void bind_pipeline(nb::module_& m) {
             return consume ? o.odometry.add_scan(std::move(s)) : o.odometry.add_scan(s);
           },
           "scan"_a, nb::kw_only(), "consume"_a = false, nb::call_guard<nb::gil_scoped_release>(),
-          "False when dropped because the worker was busy (at once with registration.wait_when_busy off; with it "
-          "on a scan waits for the busy worker, and a newer scan takes the place of one that waits, which is "
-          "then reported dropped). consume=True moves the scan's arrays in instead of copying them (the scan is "
-          "left empty).")
+          "False when dropped at once because the worker was busy (registration.max_wait_periods 0). Otherwise "
+          "a scan waits for a busy worker up to max_wait_periods; a newer scan takes the place of one that waits, "
+          "and one that waited longer is dropped when the worker comes to it (both reported as dropped frames). "
+          "consume=True moves the scan's arrays in instead of copying them (the scan is left empty).")
       .def(
           "wait_idle", [](PyOnlineOdometry& o) { o.odometry.wait_idle(); }, nb::call_guard<nb::gil_scoped_release>(),
           "Blocks until every scan handed over is processed.")

@@ -84,9 +84,11 @@ def latency_sweep(
     max_frames: int | None = None,
     plot: bool = True,
     config: Config | None = None,
+    fixed: bool = False,
 ) -> list[dict]:
     """Runs the LIO (config, default: the defaults) with each added delay on top of the measured
-    latency; writes latency_sweep.csv, latency_sweep.md and (plot) latency_sweep.png into out_dir."""
+    latency (fixed: each delay is the whole latency, a deterministic run); writes
+    latency_sweep.csv, latency_sweep.md and (plot) latency_sweep.png into out_dir."""
     rows = []
     for d in delays_s:
         s = run_dataset(
@@ -95,7 +97,7 @@ def latency_sweep(
             config if config is not None else load_config(None),
             progress=False,
             plot=False,
-            options=replay_options("measured", 0.0, d),
+            options=replay_options("fixed", d, 0.0) if fixed else replay_options("measured", 0.0, d),
             max_frames=max_frames,
         )
         ape, rpe = _accuracy(s)

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <limits>
+#include <map>
 #include <mutex>
 #include <thread>
 #include <unordered_set>
@@ -239,13 +240,15 @@ TEST(Odometry, AZeroFusionStepIsAnErrorNamingTheField) {
 
 namespace {
 
-/// The frames of rec's first scans handed to an OnlineOdometry whose worker is held in its
-/// on_frame of the first scan while the others arrive: (processed?) per scan stamp, in order.
-std::vector<std::pair<std::int64_t, bool>> scans_into_a_held_worker(bool wait_when_busy, std::size_t n,
+/// The frames of rec's first n scans handed to an OnlineOdometry whose worker is held in its
+/// on_frame of the first scan while the others arrive, and released `hold` after the last:
+/// (stamp, processed?) per scan, sorted by stamp; add_scan's answers in `accepted`.
+std::vector<std::pair<std::int64_t, bool>> scans_into_a_held_worker(double max_wait_periods, std::size_t n,
+                                                                    std::chrono::milliseconds hold,
                                                                     std::vector<bool>* accepted) {
   const Recording& rec = recording();
   Config config = deterministic_config();
-  config.registration.wait_when_busy = wait_when_busy;
+  config.registration.max_wait_periods = max_wait_periods;
   std::mutex m;
   std::condition_variable cv;
   bool first_done = false, release = false;
@@ -265,6 +268,7 @@ std::vector<std::pair<std::int64_t, bool>> scans_into_a_held_worker(bool wait_wh
     cv.wait(lock, [&] { return first_done; });
   }
   for (std::size_t i = 1; i < n; ++i) accepted->push_back(online.add_scan(rec.scans[i]));
+  std::this_thread::sleep_for(hold);
   {
     std::lock_guard lock(m);
     release = true;
@@ -278,63 +282,71 @@ std::vector<std::pair<std::int64_t, bool>> scans_into_a_held_worker(bool wait_wh
 
 }  // namespace
 
-TEST(OnlineOdometry, AScanArrivingWhileBusyWaitsAndTheNewestOfABurstWins) {
+TEST(OnlineOdometry, AScanArrivingWhileBusyWaitsBoundedAndTheNewestOfABurstWins) {
+  using std::chrono::milliseconds;
   const Recording& rec = recording();
   const auto stamp = [&](std::size_t i) { return rec.scans[i].end_stamp_ns; };
-  // a burst of three scans while the worker is busy: the last one waits, the two before it are
-  // dropped as busy (each replaced by a newer one), none is lost without a frame
+  const std::int64_t period_ns = stamp(1) - stamp(0);
+  // a burst of three scans while the worker is busy, released at once: the last one waits and is
+  // processed, the two before it are dropped as busy (each replaced by a newer one)
   std::vector<bool> accepted;
-  auto frames = scans_into_a_held_worker(true, 4, &accepted);
+  auto frames = scans_into_a_held_worker(1.0, 4, milliseconds(0), &accepted);
   EXPECT_EQ(accepted, (std::vector<bool>{true, true, true, true}));
-  const std::vector<std::pair<std::int64_t, bool>> waited = {
-      {stamp(0), true}, {stamp(1), false}, {stamp(2), false}, {stamp(3), true}};
-  EXPECT_EQ(frames, waited);
+  EXPECT_EQ(frames, (std::vector<std::pair<std::int64_t, bool>>{
+                        {stamp(0), true}, {stamp(1), false}, {stamp(2), false}, {stamp(3), true}}));
+  // a scan that waits longer than max_wait_periods is dropped when the worker comes to it
+  accepted.clear();
+  frames = scans_into_a_held_worker(0.5, 2, milliseconds(period_ns / 1'000'000 * 2), &accepted);
+  EXPECT_EQ(accepted, (std::vector<bool>{true, true}));
+  EXPECT_EQ(frames, (std::vector<std::pair<std::int64_t, bool>>{{stamp(0), true}, {stamp(1), false}}));
   // the paper's rule: every scan arriving while busy is dropped at once
   accepted.clear();
-  frames = scans_into_a_held_worker(false, 4, &accepted);
+  frames = scans_into_a_held_worker(0.0, 4, milliseconds(0), &accepted);
   EXPECT_EQ(accepted, (std::vector<bool>{true, false, false, false}));
-  const std::vector<std::pair<std::int64_t, bool>> dropped = {
-      {stamp(0), true}, {stamp(1), false}, {stamp(2), false}, {stamp(3), false}};
-  EXPECT_EQ(frames, dropped);
+  EXPECT_EQ(frames, (std::vector<std::pair<std::int64_t, bool>>{
+                        {stamp(0), true}, {stamp(1), false}, {stamp(2), false}, {stamp(3), false}}));
 }
 
-TEST(Replay, AScanArrivingWhileBusyWaitsUnlessTheNextArrivesFirst) {
-  // a fixed latency of 1.45 scan periods (no tie between an arrival and the pipeline's end): with
-  // waiting, a scan that arrives while the pipeline is busy starts when it is free, unless the next
-  // scan arrives before that (then it is dropped); without, every scan arriving while busy is dropped
+TEST(Replay, AScanArrivingWhileBusyWaitsUpToMaxWaitPeriods) {
+  // a fixed latency of 1.45 scan periods (no tie between an arrival and the pipeline's end): a
+  // scan that arrives while the pipeline is busy starts when it is free if that is at most
+  // max_wait_periods later, else it is dropped; with 0 every scan arriving while busy is dropped
   const Recording& rec = recording();
   const std::int64_t period_ns = rec.scans[1].end_stamp_ns - rec.scans[0].end_stamp_ns;
   ReplayOptions slow;
   slow.latency = LatencyModel::Fixed;
   slow.fixed_latency_s = 1.45 * static_cast<double>(period_ns) * 1e-9;
-  std::size_t processed_waiting = 0, processed_dropping = 0;
-  for (const bool wait : {true, false}) {
+  std::map<double, std::size_t> processed;
+  for (const double max_wait : {0.0, 0.5, 1.0}) {
     Config config = deterministic_config();
-    config.registration.wait_when_busy = wait;
+    config.registration.max_wait_periods = max_wait;
     Odometry replay(config, rec.T_imu_lidar, rec.gravity_m_s2, rec.imu, slow);
     std::int64_t free_ns = 0;  // when the pipeline finishes the last processed scan
     for (std::size_t i = 0; i < rec.scans.size(); ++i) {
       const Scan& s = rec.scans[i];
       const OdometryFrame f = replay.process(s);
-      const bool busy = s.end_stamp_ns < free_ns;
-      const bool next_first = free_ns > s.end_stamp_ns + period_ns;
-      SCOPED_TRACE(testing::Message() << "wait " << wait << " scan " << i);
-      if (!busy) {
+      const std::int64_t wait_ns = free_ns - s.end_stamp_ns;
+      SCOPED_TRACE(testing::Message() << "max_wait " << max_wait << " scan " << i);
+      if (wait_ns <= 0) {
         EXPECT_TRUE(f.processed);
         EXPECT_EQ(f.started_ns, s.end_stamp_ns);
-      } else if (wait && !next_first) {
+      } else if (static_cast<double>(wait_ns) <= max_wait * static_cast<double>(period_ns)) {
         EXPECT_TRUE(f.processed);
-        EXPECT_EQ(f.started_ns, free_ns);  // it waited for the pipeline, at most one period
-        EXPECT_LE(f.started_ns - s.end_stamp_ns, period_ns);
+        EXPECT_EQ(f.started_ns, free_ns);  // it waited for the pipeline
       } else {
         EXPECT_FALSE(f.processed);
         EXPECT_NE(f.drop_reason.find("still busy"), std::string::npos) << f.drop_reason;
       }
-      if (f.processed) free_ns = f.available_ns;
-      (wait ? processed_waiting : processed_dropping) += f.processed ? 1 : 0;
+      if (f.processed) {
+        EXPECT_LE(static_cast<double>(f.started_ns - s.end_stamp_ns), max_wait * static_cast<double>(period_ns));
+        free_ns = f.available_ns;
+      }
+      processed[max_wait] += f.processed ? 1 : 0;
     }
   }
   // 1.45 periods: the paper's rule processes every other scan, waiting two of every three
-  EXPECT_LE(processed_dropping, (rec.scans.size() + 1) / 2);
-  EXPECT_GE(processed_waiting, 2 * rec.scans.size() / 3);
+  const std::size_t n = rec.scans.size();
+  EXPECT_LE(processed[0.0], (n + 1) / 2);
+  EXPECT_GE(processed[0.5], 2 * n / 3);
+  EXPECT_GE(processed[1.0], 2 * n / 3);
 }

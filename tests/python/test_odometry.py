@@ -4,6 +4,7 @@ and per-frame agreement with KISS-ICP on the real KITTI scans."""
 
 from __future__ import annotations
 
+import csv
 import json
 from pathlib import Path
 
@@ -207,6 +208,30 @@ def test_ablation_and_latency_sweep_commands(tmp_path, sequences):
     )
     sweep = (tmp_path / "sw" / "latency_sweep.csv").read_text().splitlines()
     assert len(sweep) == 3 and (tmp_path / "sw" / "latency_sweep.png").exists()
+
+
+def _fixed_sweep_row(seq, out, *settings: str) -> dict:
+    args = ["latency-sweep", str(seq), "--out", str(out), "--fixed", "--delays-ms", "130", "--max-frames", "30"]
+    assert cli([*args, "--no-plot", *[a for s in settings for a in ("--set", s)]]) == 0
+    with open(out / "latency_sweep.csv") as f:
+        return next(csv.DictReader(f))
+
+
+def test_a_fixed_latency_sweep_repeats_and_drops_by_the_wait_rule(tmp_path, sequences):
+    # 130 ms of latency at 10 Hz: every scan arrives while the pipeline is busy with the previous
+    # one. The paper's rule (max_wait_periods 0) drops every other scan; waiting up to half a period
+    # drops one in three; up to a period, about one in four (docs/odometry.md, the latency sweep)
+    seq = sequences("urban", 10.0)
+    dropped = {}
+    for wait in ("0", "0.5", "1"):
+        row = _fixed_sweep_row(seq, tmp_path / f"w{wait}", f"registration.max_wait_periods={wait}")
+        dropped[wait] = int(row["dropped"])
+    assert dropped["0"] > dropped["0.5"] > dropped["1"] > 0, dropped
+    assert abs(dropped["0"] - 15) <= 1, dropped
+    # no measured time in it: the same run twice gives the same numbers
+    again = _fixed_sweep_row(seq, tmp_path / "again", "registration.max_wait_periods=0.5")
+    assert int(again["dropped"]) == dropped["0.5"]
+    assert again == _fixed_sweep_row(seq, tmp_path / "again2", "registration.max_wait_periods=0.5")
 
 
 def test_racetrack_lio_beats_lidar_only(runs):

@@ -132,10 +132,10 @@ inline constexpr double kMaxThreads = 1024.0;
         "|dx| (6-vector, m and rad) above which the next Gauss-Newton iteration is coarse (coarse_stride)")       \
   FIELD(double, time_budget_factor, 2.0, range::positive_up_to_or_inf(kMaxRatio),                                 \
         "time budget in LiDAR periods (paper: 2); a frame over it is dropped (inf: no budget)")                   \
-  FIELD(bool, wait_when_busy, true, range::unchecked(),                                                           \
-        "a scan that arrives while the pipeline is busy waits for it, unless a newer scan arrives first (then "   \
-        "the older is dropped): a burst from the transport loses no scan, latency stays under two frames; "       \
-        "false: dropped at once (the paper)")                                                                     \
+  FIELD(double, max_wait_periods, 0.5, range::between(0.0, 1.0),                                                  \
+        "a scan that arrives while the pipeline is busy waits for it up to this many LiDAR periods (a newer "     \
+        "scan arriving meanwhile takes its place); one that would wait longer is dropped: a burst from the "      \
+        "transport loses no scan and latency stays bounded; 0: dropped at once (the paper)")                      \
   FIELD(double, damping, 1e-9, range::non_negative_up_to(kMaxRatio), "lambda added to the diagonal of H")         \
   FIELD(double, covariance_scale, 0.05, range::positive_up_to(kMaxRatio),                                         \
         "pose covariance = covariance_scale * H^-1 (H in the factors' normalised units; docs/fusion.md measures " \

@@ -49,7 +49,7 @@ void validate_replay_options(const ReplayOptions& options) {
 Odometry::Odometry(const Config& config, const SE3& T_imu_lidar, double gravity_m_s2, std::vector<ImuSample> imu,
                    const ReplayOptions& options)
     : options_(options),
-      wait_when_busy_(config.registration.wait_when_busy),
+      max_wait_periods_(config.registration.max_wait_periods),
       T_imu_lidar_(T_imu_lidar),
       T_lidar_imu_(T_imu_lidar.inverse()),
       imu_(std::move(imu)),
@@ -112,9 +112,10 @@ double Odometry::latency_s(const FrameResult& r) const {
 
 bool Odometry::dropped_as_busy(const Scan& scan, std::int64_t previous_end_ns) const {
   if (scan.end_stamp_ns >= busy_until_ns_) return false;  // the pipeline is free when it arrives
-  // it waits unless the next scan, one period later, arrives while the pipeline is still busy
-  const std::int64_t next_arrival_ns = scan.end_stamp_ns + (scan.end_stamp_ns - previous_end_ns);
-  return !wait_when_busy_ || busy_until_ns_ > next_arrival_ns;
+  // it waits for the pipeline up to max_wait_periods (<= 1: the next scan, one period later, has
+  // not arrived by then)
+  const auto period_ns = static_cast<double>(scan.end_stamp_ns - previous_end_ns);
+  return static_cast<double>(busy_until_ns_ - scan.end_stamp_ns) > max_wait_periods_ * period_ns;
 }
 
 OdometryFrame Odometry::process(const Scan& scan) {

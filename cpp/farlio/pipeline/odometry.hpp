@@ -9,10 +9,10 @@
 //   its result becomes available after the latency (measured processing time, zero, a fixed
 //   value, plus an optional added delay) and is fused as a delayed measurement;
 //   the fusion's output at every 10 ms step is the odometry.
-// A scan that arrives while the pipeline is still busy waits for it, as in the online odometry
-// (registration.wait_when_busy), unless the next scan (one period later) would arrive first: then
-// it is dropped, as it always is with wait_when_busy off (the paper). A scan whose registration
-// ran out of its time budget is dropped. Without IMU samples, or with fusion.enabled off,
+// A scan that arrives while the pipeline is still busy waits for it up to
+// registration.max_wait_periods, as in the online odometry, and is dropped when it would wait
+// longer (at once with 0, as in the paper). A scan whose registration ran out of its time budget
+// is dropped. Without IMU samples, or with fusion.enabled off,
 // the scan pipeline runs alone on its constant-velocity model (LiDAR-only odometry).
 // The clock starts at the first IMU sample, or at the first scan when that ends earlier: scans
 // before the IMU starts run LiDAR-only (as in the online odometry), the fusion takes over from
@@ -79,11 +79,11 @@ class Odometry {
  private:
   void advance_clock(std::int64_t stamp_ns);
   [[nodiscard]] double latency_s(const FrameResult& r) const;
-  /// Whether the scan arrives (at its end stamp) while the pipeline is busy and does not wait.
+  /// Whether the scan arrives (at its end stamp) while the pipeline is busy and would wait too long.
   [[nodiscard]] bool dropped_as_busy(const Scan& scan, std::int64_t previous_end_ns) const;
 
   ReplayOptions options_;
-  bool wait_when_busy_;
+  double max_wait_periods_;
   SE3 T_imu_lidar_, T_lidar_imu_;
   SE3 initial_body_pose_;
   std::optional<SE3> requested_initial_pose_;  ///< set_initial_pose

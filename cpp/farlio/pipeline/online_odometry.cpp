@@ -48,21 +48,30 @@ bool OnlineOdometry::add_scan(Scan scan) {
   std::optional<Scan> replaced;  // the scan that waited, when this newer one takes its place
   {
     std::lock_guard lock(queue_mutex_);
-    if (!stopping_ && (!busy_ || config_.registration.wait_when_busy)) {
+    const std::int64_t period_ns = last_added_end_ns_ ? scan.end_stamp_ns - *last_added_end_ns_ : 0;
+    last_added_end_ns_ = scan.end_stamp_ns;
+    const double max_wait_ns = config_.registration.max_wait_periods * static_cast<double>(period_ns);
+    if (!stopping_ && (!busy_ || max_wait_ns > 0.0)) {
       if (pending_) replaced = std::move(pending_);
       pending_ = std::move(scan);
+      pending_deadline_ = busy_ ? SteadyClock::now() + std::chrono::nanoseconds(static_cast<std::int64_t>(max_wait_ns))
+                                : SteadyClock::time_point::max();
       busy_ = true;
       accepted = true;
     }
   }
   if (accepted) queue_cv_.notify_all();
   if (accepted && !replaced) return true;
+  drop_busy(replaced ? *replaced : scan);
+  return accepted;
+}
+
+void OnlineOdometry::drop_busy(const Scan& scan) {
   {
     std::lock_guard lock(state_mutex_);
     ++dropped_busy_;
   }
-  if (on_frame_) on_frame_(busy_frame(replaced ? *replaced : scan));
-  return accepted;
+  if (on_frame_) on_frame_(busy_frame(scan));
 }
 
 void OnlineOdometry::wait_idle() {
@@ -73,15 +82,21 @@ void OnlineOdometry::wait_idle() {
 void OnlineOdometry::worker_loop() {
   for (;;) {
     Scan scan;
+    bool stale = false;
     {
       std::unique_lock lock(queue_mutex_);
       queue_cv_.wait(lock, [this] { return pending_.has_value() || stopping_; });
       if (!pending_) return;  // stopping with nothing left
       scan = std::move(*pending_);
       pending_.reset();
+      stale = SteadyClock::now() > pending_deadline_;  // it waited longer than max_wait_periods
     }
-    const OdometryFrame frame = process(scan);
-    if (on_frame_) on_frame_(frame);
+    if (stale) {
+      drop_busy(scan);
+    } else {
+      const OdometryFrame frame = process(scan);
+      if (on_frame_) on_frame_(frame);
+    }
     {
       std::lock_guard lock(queue_mutex_);
       busy_ = pending_.has_value();  // a scan that waited is next

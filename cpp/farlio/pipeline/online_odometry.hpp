@@ -8,10 +8,11 @@
 // Threads: add_imu() and add_scan() may be called from any threads (each kind in time order).
 // on_odometry runs on the thread that called add_imu(); on_frame runs on the worker (or on the
 // add_scan() caller for a dropped scan). Callbacks must not call back into the object.
-// A scan that arrives while the worker is still busy waits in a slot of one
-// (registration.wait_when_busy): a newer scan arriving before the worker is free takes its place
-// and the older is dropped, so a burst from the transport loses no scan and a scan waits at most
-// one frame; with wait_when_busy off it is dropped at once (as in the paper). With
+// A scan that arrives while the worker is still busy waits in a slot of one, up to
+// registration.max_wait_periods of its LiDAR period: a newer scan arriving meanwhile takes its
+// place (the older is dropped), and one that waited longer is dropped when the worker comes to it.
+// So a burst from the transport loses no scan and latency stays bounded; with 0 a scan arriving
+// while busy is dropped at once (as in the paper), the rule of the replay (odometry.hpp). With
 // fusion.enabled off, or until the first IMU sample arrives, the odometry is LiDAR-only and
 // on_odometry is not called; the fusion takes over with the first scan after the first IMU
 // sample (scans before it are registered, not fused; the world frame is then not gravity
@@ -20,6 +21,7 @@
 // reports what happened.
 // With keep_registered_points, every processed frame carries its registered scan (world frame),
 // for a live view; map_snapshot() copies the submap between two scans.
+#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
@@ -58,8 +60,8 @@ class OnlineOdometry {
   /// Feeds the fusion and emits the odometry for every 10 ms step up to the sample's stamp.
   void add_imu(const ImuSample& sample);
   /// Hands the scan to the worker (to wait for it when it is busy); false (and on_frame with the
-  /// reason) when it is dropped. A scan that was waiting and is replaced gets on_frame with the
-  /// reason here too.
+  /// reason) when it is dropped at once. A scan that was waiting and is replaced gets on_frame
+  /// with the reason here; one that waited too long, when the worker comes to it.
   bool add_scan(Scan scan);
   /// Blocks until the worker has finished every scan handed to it (the waiting one included).
   void wait_idle();
@@ -85,6 +87,8 @@ class OnlineOdometry {
 
  private:
   void worker_loop();
+  /// Counts the scan as dropped because the worker was busy and reports its frame.
+  void drop_busy(const Scan& scan);
   OdometryFrame process(const Scan& scan);
   /// Whether time is the IMU's (the fusion runs and has samples), else the scan stamps'.
   [[nodiscard]] bool fused_clock() const;
@@ -107,11 +111,14 @@ class OnlineOdometry {
   // worker, guarded by queue_mutex_
   std::mutex queue_mutex_;
   std::condition_variable queue_cv_;
-  std::optional<Scan> pending_;           ///< the scan the worker takes next
-  bool busy_ = false, stopping_ = false;  ///< busy: a scan is processed or waiting
-  mutable std::mutex pipeline_mutex_;     // held by the worker while it processes, and by map_snapshot
-  ScanPipeline pipeline_;                 // its backend made at construction; the start pose set at the first scan
-  std::thread worker_;                    // last: started when everything above is constructed
+  using SteadyClock = std::chrono::steady_clock;
+  std::optional<Scan> pending_;                    ///< the scan the worker takes next
+  SteadyClock::time_point pending_deadline_;       ///< dropped when the worker comes to it later
+  std::optional<std::int64_t> last_added_end_ns_;  ///< end stamp of the previous scan handed in
+  bool busy_ = false, stopping_ = false;           ///< busy: a scan is processed or waiting
+  mutable std::mutex pipeline_mutex_;              // held by the worker while it processes, and by map_snapshot
+  ScanPipeline pipeline_;  // its backend made at construction; the start pose set at the first scan
+  std::thread worker_;     // last: started when everything above is constructed
 };
 
 }  // namespace farlio::pipeline

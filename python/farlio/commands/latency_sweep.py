@@ -20,7 +20,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         type=non_negative_float,
         nargs="+",
         default=DEFAULT_DELAYS_MS,
-        help="delays added to the measured processing time",
+        help="delays added to the measured processing time (with --fixed: the latencies)",
+    )
+    parser.add_argument(
+        "--fixed",
+        action="store_true",
+        help="each delay is the whole latency (the fixed latency model, no measured time): runs that repeat "
+        "exactly, for comparing settings",
     )
     parser.add_argument("--max-frames", type=positive_int, default=None, help="stop each run after this many scans")
     parser.add_argument("--no-plot", action="store_true", help="no latency_sweep.png")
@@ -35,10 +41,11 @@ def run(args: argparse.Namespace) -> int:
         max_frames=args.max_frames,
         plot=not args.no_plot,
         config=load_config(args.config, args.overrides),
+        fixed=args.fixed,
     )
     for r in rows:
         print(
-            f"added {r['added_delay_ms']:6.0f} ms: APE {r['ape_m']:.3f} m, RPE {r['rpe_pct']:.3f} %, "
+            f"{'latency' if args.fixed else 'added'} {r['added_delay_ms']:6.0f} ms: APE {r['ape_m']:.3f} m, RPE {r['rpe_pct']:.3f} %, "
             f"dropped {r['dropped']}"
         )
     return 0
