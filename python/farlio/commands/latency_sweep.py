@@ -43,9 +43,10 @@ def run(args: argparse.Namespace) -> int:
         config=load_config(args.config, args.overrides),
         fixed=args.fixed,
     )
+    what = "latency" if args.fixed else "added"
     for r in rows:
         print(
-            f"{'latency' if args.fixed else 'added'} {r['added_delay_ms']:6.0f} ms: APE {r['ape_m']:.3f} m, RPE {r['rpe_pct']:.3f} %, "
+            f"{what} {r['added_delay_ms']:6.0f} ms: APE {r['ape_m']:.3f} m, RPE {r['rpe_pct']:.3f} %, "
             f"dropped {r['dropped']}"
         )
     return 0
