@@ -82,8 +82,9 @@ class SensorFusion {
   /// The filter step (FusionConfig::step_s) in ns.
   [[nodiscard]] std::int64_t step_ns() const { return step_ns_; }
   [[nodiscard]] BodyEstimate estimate() const;
-  /// The pose at stamp_ns from the history, or predicted with the last input up to
-  /// max_extrapolation_s beyond the newest step; nullopt otherwise.
+  /// The pose at stamp_ns as the filter now estimates it: the history's state plus the corrections
+  /// applied since (as delay compensation shifts a past state), or predicted with the last input
+  /// up to max_extrapolation_s beyond the newest step; nullopt otherwise.
   [[nodiscard]] std::optional<SE3> pose_at(std::int64_t stamp_ns) const;
   /// The bias-corrected angular rate used in the last step (rad/s, body frame).
   [[nodiscard]] Eigen::Vector3d angular_velocity_body() const { return corrected_last_input().segment<3>(kGyroIndex); }
