@@ -68,10 +68,10 @@ class NodeProcess:
     def alive(self) -> bool:
         return self.proc.poll() is None
 
-    def stop(self) -> int:
-        """SIGINT, as Ctrl-C does; the exit status."""
+    def stop(self, sig: int = signal.SIGINT) -> int:
+        """SIGINT, as Ctrl-C does (or `sig`); the exit status."""
         if self.alive():
-            self.proc.send_signal(signal.SIGINT)
+            self.proc.send_signal(sig)
         try:
             rc = self.proc.wait(STOP_TIMEOUT_S)
         except subprocess.TimeoutExpired:

@@ -1,9 +1,10 @@
 """`farlio ros2` on other inputs over loopback: two LiDAR topics merged back into one scan per period,
-a LiDAR clock off the IMU clock undone by time_offset_s, and clouds that cannot be used (no x/y/z,
-only NaN, a repeated stamp) reported without stopping the node."""
+a LiDAR clock off the IMU clock undone by time_offset_s, clouds that cannot be used (no x/y/z,
+only NaN, a repeated stamp) reported without stopping the node, and SIGTERM."""
 
 from __future__ import annotations
 
+import signal
 import time
 
 import numpy as np
@@ -121,3 +122,12 @@ def test_unusable_clouds_are_reported_and_the_node_goes_on(urban, recorder, star
     assert last["mode"] == "lidar-only"
     log = node.text()
     assert "no field 'x'" in log and "LiDAR-only" in log and "Traceback" not in log, log
+
+
+def test_sigterm_stops_the_node_cleanly(recorder, start_node):
+    # what `ros2 launch` sends after SIGINT: the same clean stop, counters printed, exit status 0
+    node = start_node("imu_topic:=none")
+    recorder.wait_for_node(node)
+    assert node.stop(signal.SIGTERM) == 0
+    log = node.text()
+    assert "farlio stopped" in log and "Traceback" not in log, log

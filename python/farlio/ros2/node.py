@@ -9,6 +9,7 @@ odometry, the registered cloud, the diagnostics and, at a low rate, the local ma
 
 from __future__ import annotations
 
+import signal
 import sys
 import threading
 import time
@@ -23,6 +24,7 @@ from rclpy.clock import Clock, ClockType
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.signals import SignalHandlerOptions
 from sensor_msgs.msg import Imu, PointCloud2
 from std_srvs.srv import Trigger
 
@@ -44,6 +46,9 @@ except ImportError:
 WATCHDOG_PERIOD_S = 0.05
 #: how long the result thread waits for a frame before it looks at its stop flag
 RESULT_WAIT_S = 0.1
+#: how long the executor waits for work before it looks at the stop flag SIGINT/SIGTERM set
+SPIN_TIMEOUT_S = 0.1
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 DEFAULT_GRAVITY_M_S2 = 9.81
 MS_PER_S = 1000.0
 ODOMETRY_DEPTH, CLOUD_DEPTH, DIAGNOSTICS_DEPTH = 100, 2, 20
@@ -286,10 +291,16 @@ class FarlioNode(Node):
 
 
 def run(ros_args: list[str], transport: str = "") -> int:
-    """`farlio ros2 [--ros-args ...]`: runs the node until SIGINT (or the context shuts down);
-    `transport` says which DDS transport settings are in use (for the log)."""
+    """`farlio ros2 [--ros-args ...]`: runs the node until SIGINT or SIGTERM (or the context shuts
+    down); `transport` says which DDS transport settings are in use (for the log).
+
+    The signals only set a flag that the spin loop looks at between callbacks: with rclpy's own
+    handler a KeyboardInterrupt could land inside rclpy (once in a loopback run it left a
+    half-made Task whose __del__ printed a traceback at exit)."""
     memory_kept = retain_freed_memory()  # before the first cloud's buffers
-    rclpy.init(args=[NODE_NAME, *ros_args])
+    rclpy.init(args=[NODE_NAME, *ros_args], signal_handler_options=SignalHandlerOptions.NO)
+    stop = threading.Event()
+    previous = {s: signal.signal(s, lambda *_: stop.set()) for s in STOP_SIGNALS}
     node = None
     try:
         node = FarlioNode()
@@ -299,14 +310,17 @@ def run(ros_args: list[str], transport: str = "") -> int:
             node.get_logger().info("the allocator is not glibc's: its own policy for freed memory applies")
         executor = SingleThreadedExecutor()
         executor.add_node(node)
-        executor.spin()
-    except (KeyboardInterrupt, ExternalShutdownException):
+        while not stop.is_set() and rclpy.ok():
+            executor.spin_once(timeout_sec=SPIN_TIMEOUT_S)
+    except ExternalShutdownException:
         pass
     finally:
         if node is not None:
             node.close()
             node.destroy_node()
         rclpy.try_shutdown()
+        for s, handler in previous.items():
+            signal.signal(s, handler)
     return 0
 
 
