@@ -30,6 +30,15 @@ SimOptions noisy_options(double duration_s) {
   o.lidar_rotation_noise_rad = 0.1 / kDegPerRad;
   return o;
 }
+/// IMU rate of the prediction-only run the pose_at tests query.
+constexpr double kPredictionImuHz = 400.0;
+/// Runs f on fast_curve() with the IMU alone (after its first LiDAR result) for one second.
+void predict_fast_curve(fusion::SensorFusion& f) {
+  SimOptions o;
+  o.imu_hz = kPredictionImuHz;
+  o.lidar_hz = 0.0;
+  simulate(fast_curve(), plain_config(), o, &f);
+}
 FusionConfig matched_config() {
   FusionConfig c;
   c.lidar_position_std_m = 0.02;
@@ -193,10 +202,7 @@ TEST(FusionSensor, TooOldLidarAndOutOfOrderImuAreRejected) {
 
 TEST(FusionSensor, PoseAtInterpolatesTheHistory) {
   fusion::SensorFusion f(plain_config(), kGravity_m_s2);
-  SimOptions o;
-  o.imu_hz = 400.0;
-  o.lidar_hz = 0.0;
-  simulate(fast_curve(), plain_config(), o, &f);
+  predict_fast_curve(f);
   for (double t : {0.2, 0.355, 0.999, 1.0}) {
     const auto pose = f.pose_at(seconds_to_ns(t));
     ASSERT_TRUE(pose.has_value()) << t;
@@ -216,15 +222,12 @@ TEST(FusionSensor, PoseAtAPastStampCarriesTheCorrectionsFusedSince) {
   // those past instants where its correction moved the present (as delay compensation does), so
   // a scan that ends there but starts after the result gets the corrected guess
   fusion::SensorFusion f(plain_config(), kGravity_m_s2);
-  SimOptions o;
-  o.imu_hz = 400.0;
-  o.lidar_hz = 0.0;
-  simulate(fast_curve(), plain_config(), o, &f);
+  predict_fast_curve(f);
   const SE3 before_a = *f.pose_at(seconds_to_ns(0.5)), before_b = *f.pose_at(seconds_to_ns(0.85));
   const SE3 truth = fast_curve().pose(0.9);
   const Eigen::Vector3d offset(0.3, 0.0, 0.0);
   f.add_lidar(seconds_to_ns(0.9), SE3(truth.rotation(), truth.translation() + offset), Eigen::Vector3d::Zero(), false);
-  for (double t = 1.0 + 1.0 / o.imu_hz; t <= 1.3; t += 1.0 / o.imu_hz) f.add_imu(fast_curve().imu(t));
+  for (double t = 1.0 + 1.0 / kPredictionImuHz; t <= 1.3; t += 1.0 / kPredictionImuHz) f.add_imu(fast_curve().imu(t));
   f.advance_to(seconds_to_ns(1.3));
   const Eigen::Vector3d moved_a = f.pose_at(seconds_to_ns(0.5))->translation() - before_a.translation();
   const Eigen::Vector3d moved_b = f.pose_at(seconds_to_ns(0.85))->translation() - before_b.translation();

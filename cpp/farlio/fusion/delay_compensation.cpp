@@ -26,7 +26,7 @@ ArrivalResidual arrival_residual(MeasurementKind kind, const Eigen::VectorXd& z_
     return out;
   }
   const StampedState past = *history.entry_at(stamp_ns);
-  const StateVector x_s = normalized_state(past.x + (current_correction - past.cumulative_correction));
+  const StateVector x_s = corrected_since(past, current_correction);
   out.residual = measurement_difference(kind, shifted_measurement(kind, z_s, x_s, x_now), h_now);
   return out;
 }

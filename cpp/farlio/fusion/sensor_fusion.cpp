@@ -291,14 +291,12 @@ std::optional<SE3> SensorFusion::pose_at(std::int64_t stamp_ns) const {
   if (!initialized() || history_.empty()) return std::nullopt;
   // the corrections applied since that step move the past as they moved the present (the x_s of
   // delay compensation, eq. 10): a scan that starts after a later result was fused gets it too
-  const auto corrected = [&](const StampedState& e) {
-    return normalized_state(e.x + (cumulative_correction_ - e.cumulative_correction));
-  };
-  if (const auto entry = history_.entry_at(stamp_ns)) return pose_of(corrected(*entry));
+  if (const auto entry = history_.entry_at(stamp_ns)) return pose_of(corrected_since(*entry, cumulative_correction_));
   const StampedState& newest = history_.newest();
   const double ahead_s = ns_to_seconds(stamp_ns - newest.stamp_ns);
   if (ahead_s <= 0.0 || ahead_s > config_.max_extrapolation_s) return std::nullopt;
-  return pose_of(integrate_step(corrected(newest), last_input_, last_input_, last_input_, ahead_s, gravity_m_s2_));
+  const StateVector x = corrected_since(newest, cumulative_correction_);
+  return pose_of(integrate_step(x, last_input_, last_input_, last_input_, ahead_s, gravity_m_s2_));
 }
 
 FusionStats SensorFusion::stats() const {

@@ -57,4 +57,8 @@ std::optional<StampedState> StateHistory::entry_at(std::int64_t stamp_ns) const 
                       a.cumulative_correction + s * (b.cumulative_correction - a.cumulative_correction)};
 }
 
+StateVector corrected_since(const StampedState& past, const StateVector& current_correction) {
+  return normalized_state(past.x + (current_correction - past.cumulative_correction));
+}
+
 }  // namespace farlio::fusion

@@ -46,4 +46,8 @@ class StateHistory {
 /// Interpolates between two states (s in [0, 1]) as StateHistory::state_at does.
 StateVector interpolate_states(const StateVector& a, const StateVector& b, double s);
 
+/// A past entry moved by the corrections applied since it was stored (`current_correction`: the
+/// cumulative correction now): where the filter now puts that instant, the x_s of eq. 10.
+StateVector corrected_since(const StampedState& past, const StateVector& current_correction);
+
 }  // namespace farlio::fusion
