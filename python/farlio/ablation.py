@@ -89,12 +89,13 @@ def latency_sweep(
     """Runs the LIO (config, default: the defaults) with each added delay on top of the measured
     latency (fixed: each delay is the whole latency, a deterministic run); writes
     latency_sweep.csv, latency_sweep.md and (plot) latency_sweep.png into out_dir."""
+    config = config if config is not None else load_config(None)
     rows = []
     for d in delays_s:
         s = run_dataset(
             open_dataset(sequence),
             out_dir / f"delay_{d * 1e3:.0f}ms",
-            config if config is not None else load_config(None),
+            config,
             progress=False,
             plot=False,
             options=replay_options("fixed", d, 0.0) if fixed else replay_options("measured", 0.0, d),

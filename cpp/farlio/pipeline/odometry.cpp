@@ -114,8 +114,8 @@ bool Odometry::dropped_as_busy(const Scan& scan, std::int64_t previous_end_ns) c
   if (scan.end_stamp_ns >= busy_until_ns_) return false;  // the pipeline is free when it arrives
   // it waits for the pipeline up to max_wait_periods (<= 1: the next scan, one period later, has
   // not arrived by then)
-  const auto period_ns = static_cast<double>(scan.end_stamp_ns - previous_end_ns);
-  return static_cast<double>(busy_until_ns_ - scan.end_stamp_ns) > max_wait_periods_ * period_ns;
+  return static_cast<double>(busy_until_ns_ - scan.end_stamp_ns) >
+         busy_wait_limit_ns(max_wait_periods_, scan.end_stamp_ns, previous_end_ns);
 }
 
 OdometryFrame Odometry::process(const Scan& scan) {

@@ -38,6 +38,13 @@ struct OdometrySample {
   Eigen::Vector3d velocity_body_m_s = Eigen::Vector3d::Zero();
 };
 
+/// How long (ns) a scan ending at end_ns may wait for a busy pipeline: max_wait_periods
+/// (registration.max_wait_periods) of the time since the previous scan's end; <= 0: not at all.
+/// The one rule of the replay and the online odometry.
+inline double busy_wait_limit_ns(double max_wait_periods, std::int64_t end_ns, std::int64_t previous_end_ns) {
+  return max_wait_periods * static_cast<double>(end_ns - previous_end_ns);
+}
+
 /// The frame of a scan that arrived while the scan pipeline was still busy with the previous one
 /// (dropped unprocessed, as in the paper).
 inline OdometryFrame busy_frame(const Scan& scan) {

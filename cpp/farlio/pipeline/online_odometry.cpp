@@ -1,6 +1,7 @@
 #include "farlio/pipeline/online_odometry.hpp"
 
 #include <stdexcept>
+#include <utility>
 
 #include "farlio/core/config_fields.hpp"
 #include "farlio/core/time.hpp"
@@ -48,9 +49,8 @@ bool OnlineOdometry::add_scan(Scan scan) {
   std::optional<Scan> replaced;  // the scan that waited, when this newer one takes its place
   {
     std::lock_guard lock(queue_mutex_);
-    const std::int64_t period_ns = last_added_end_ns_ ? scan.end_stamp_ns - *last_added_end_ns_ : 0;
-    last_added_end_ns_ = scan.end_stamp_ns;
-    const double max_wait_ns = config_.registration.max_wait_periods * static_cast<double>(period_ns);
+    const double max_wait_ns = busy_wait_limit_ns(config_.registration.max_wait_periods, scan.end_stamp_ns,
+                                                  std::exchange(last_added_end_ns_, scan.end_stamp_ns));
     if (!stopping_ && (!busy_ || max_wait_ns > 0.0)) {
       if (pending_) replaced = std::move(pending_);
       pending_ = std::move(scan);

@@ -112,13 +112,13 @@ class OnlineOdometry {
   std::mutex queue_mutex_;
   std::condition_variable queue_cv_;
   using SteadyClock = std::chrono::steady_clock;
-  std::optional<Scan> pending_;                    ///< the scan the worker takes next
-  SteadyClock::time_point pending_deadline_;       ///< dropped when the worker comes to it later
-  std::optional<std::int64_t> last_added_end_ns_;  ///< end stamp of the previous scan handed in
-  bool busy_ = false, stopping_ = false;           ///< busy: a scan is processed or waiting
-  mutable std::mutex pipeline_mutex_;              // held by the worker while it processes, and by map_snapshot
-  ScanPipeline pipeline_;  // its backend made at construction; the start pose set at the first scan
-  std::thread worker_;     // last: started when everything above is constructed
+  std::optional<Scan> pending_;               ///< the scan the worker takes next
+  SteadyClock::time_point pending_deadline_;  ///< dropped when the worker comes to it later
+  std::int64_t last_added_end_ns_ = 0;        ///< end stamp of the previous scan handed in
+  bool busy_ = false, stopping_ = false;      ///< busy: a scan is processed or waiting
+  mutable std::mutex pipeline_mutex_;         // held by the worker while it processes, and by map_snapshot
+  ScanPipeline pipeline_;                     // its backend made at construction; the start pose set at the first scan
+  std::thread worker_;                        // last: started when everything above is constructed
 };
 
 }  // namespace farlio::pipeline
