@@ -227,6 +227,7 @@ void bind_pipeline(nb::module_& m) {
       .def_prop_ro("hessian", [](const pipeline::FrameResult& r) { return r.registration.system.H; })
       .def_prop_ro("gradient", [](const pipeline::FrameResult& r) { return r.registration.system.b; })
       .def_ro("sigma_m", &pipeline::FrameResult::sigma_m)
+      .def_ro("kernel_scale_m", &pipeline::FrameResult::kernel_scale_m)
       .def_ro("density_limit", &pipeline::FrameResult::density_limit)
       .def_ro("input_points", &pipeline::FrameResult::input_points)
       .def_ro("kept_points", &pipeline::FrameResult::kept_points)
@@ -235,8 +236,8 @@ void bind_pipeline(nb::module_& m) {
       .def_ro("map_points", &pipeline::FrameResult::map_points)
       .def_ro("timings", &pipeline::FrameResult::timings)
       .def("__repr__", attribute_repr({"stamp_ns", "pose", "registered", "converged", "iterations", "inliers",
-                                       "sigma_m", "density_limit", "input_points", "kept_points", "source_points",
-                                       "map_voxels", "map_points", "timings"}));
+                                       "sigma_m", "kernel_scale_m", "density_limit", "input_points", "kept_points",
+                                       "source_points", "map_voxels", "map_points", "timings"}));
 
   nb::class_<registration::RegistrationResult>(m, "RegistrationResult", "Pose with the Gauss-Newton system.")
       .def_ro("pose", &registration::RegistrationResult::pose)

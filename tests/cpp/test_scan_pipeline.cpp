@@ -111,6 +111,30 @@ TEST(ScanPipeline, ADegenerateScanFailsKeepsThePredictionAndChangesNothing) {
   }
 }
 
+// The Cauchy kernel scale: sigma / 3 (KISS-ICP) with the constant-velocity guess, at most
+// registration.fused_kernel_scale_m with a guess from another sensor (the fusion's), never wider.
+TEST(ScanPipeline, AGuessFromTheFusionCapsTheKernelScale) {
+  const double period = 0.1;
+  for (const double cap_m : {0.2, 10.0}) {
+    Config cfg;
+    cfg.num_threads = 2;
+    cfg.registration.time_budget_factor = 1e6;
+    cfg.registration.fused_kernel_scale_m = cap_m;
+    pipeline::ScanPipeline p(cfg, truth_at(period));
+    for (int k = 0; k < 3; ++k) {
+      const auto r = p.process(make_scan(k, period));
+      if (k > 0) EXPECT_DOUBLE_EQ(r.kernel_scale_m, r.sigma_m / 3.0) << "constant velocity, frame " << k;
+    }
+    for (int k = 3; k < 8; ++k) {
+      const SE3 guess = truth_at((k + 1) * period);
+      const auto r = p.process(make_scan(k, period), guess);
+      ASSERT_TRUE(r.failure.empty()) << r.failure;
+      EXPECT_DOUBLE_EQ(r.kernel_scale_m, std::min(r.sigma_m / 3.0, cap_m)) << "fusion's guess, frame " << k;
+      EXPECT_LT(translation_error_m(r.pose, guess), 0.03);
+    }
+  }
+}
+
 // Recovery: when registrations fail for map_restart_after_s (the old map no longer matches), the
 // map restarts from the current scan at the prediction, and tracking resumes from there.
 TEST(ScanPipeline, PersistentFailuresRestartTheMapAndTrackingResumes) {

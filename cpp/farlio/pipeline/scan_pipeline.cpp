@@ -134,9 +134,14 @@ FrameResult ScanPipeline::process(const Scan& scan, const std::optional<SE3>& in
     // (racetrack launch seed 2: APE 0.16 -> 1.12 m when held there).
     RegistrationConfig reg = config_.registration;
     reg.hold_degenerate_directions = reg.hold_degenerate_directions && initial_guess.has_value();
-    out.registration =
-        backend_->register_source(out.initial_guess, registration::Thresholds::from_sigma(out.sigma_m, p2p), reg,
-                                  config_.registration.time_budget_factor * period_s);
+    // The kernel scale sigma / 3 follows the constant-velocity model's deviations; the fusion's
+    // guess deviates far less than sigma says (registration.fused_kernel_scale_m).
+    registration::Thresholds thresholds = registration::Thresholds::from_sigma(out.sigma_m, p2p);
+    if (initial_guess)
+      thresholds.kernel_scale_m = std::min(thresholds.kernel_scale_m, config_.registration.fused_kernel_scale_m);
+    out.kernel_scale_m = thresholds.kernel_scale_m;
+    out.registration = backend_->register_source(out.initial_guess, thresholds, reg,
+                                                 config_.registration.time_budget_factor * period_s);
     out.registered = true;
     out.inlier_fraction = static_cast<double>(out.registration.system.inliers) / static_cast<double>(source.points);
     out.failure = registration::failure_reason(out.registration, source.points, config_.registration);

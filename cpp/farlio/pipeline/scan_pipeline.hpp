@@ -47,6 +47,7 @@ struct FrameResult {
   deskew::ScanMotion motion;  ///< the motion the scan was undistorted with
   bool undistorted = false;   ///< whether it was (per-point times, preprocess.undistort, motion)
   double sigma_m = 0;         ///< adaptive threshold used
+  double kernel_scale_m = 0;  ///< Cauchy kernel scale used (sigma / 3, or registration.fused_kernel_scale_m)
   int density_limit = 0;      ///< close-range per-voxel limit chosen by ASMD
   std::size_t input_points = 0, kept_points = 0, source_points = 0;
   map::InsertStats map_insert;
