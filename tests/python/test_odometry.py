@@ -20,8 +20,9 @@ from farlio.simulation import generate
 
 # (profile, seconds, mode, scan-pose APE RMSE bound m, KITTI-style RPE bound %, 100 Hz odometry
 # APE bound m). Measured with a fixed 20 ms latency (seed 1), bounds ~3x above:
-#   urban 10 s     LIO: APE 0.012 m, RPE 0.09 %, odometry APE 0.015 m; LiDAR-only: 0.015 m, 0.11 %
-#   handheld 25 s  LIO: APE 0.008 m, RPE 0.17 %, odometry APE 0.015 m; LiDAR-only: 0.100 m, 2.0 %
+#   urban 10 s     LIO: APE 0.006 m, RPE 0.05 %, odometry APE 0.007 m; LiDAR-only: 0.008 m, 0.07 %
+#   handheld 25 s  LIO: APE 0.011 m, RPE 0.12 %, odometry APE 0.013 m; LiDAR-only: 0.092 m, 1.9 %
+#   (these two: scripts/measure_accuracy.py, stop 26)
 #   racetrack 6 s  LIO: APE 0.034 m, RPE 0.20 %, odometry APE 0.038 m; LiDAR-only: 0.051 m, 0.35 %
 #                  (standing start, launch to 12 m/s: the case of docs/odometry.md "racetrack launch")
 # (LiDAR-only suffers from the 3 rad/s head turns under its constant-velocity model.)

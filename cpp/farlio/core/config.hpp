@@ -136,11 +136,11 @@ inline constexpr double kMaxThreads = 1024.0;
         "a scan that arrives while the pipeline is busy waits for it up to this many LiDAR periods (a newer "     \
         "scan arriving meanwhile takes its place); one that would wait longer is dropped: a burst from the "      \
         "transport loses no scan and latency stays bounded; 0: dropped at once (the paper)")                      \
-  FIELD(double, fused_kernel_scale_m, 0.2, range::positive_up_to(kMaxSiValue),                                    \
+  FIELD(double, fused_kernel_scale_m, 0.25, range::positive_up_to(kMaxSiValue),                                   \
         "LIO: the Cauchy kernel scale is at most this when the initial guess is the fusion's prediction. "        \
         "KISS-ICP's sigma / 3 measures a constant-velocity guess; the IMU's guess deviates less than "            \
         "threshold.min_motion_m, so sigma keeps its initial value and sigma / 3 lets wrong matches pull "         \
-        "(docs/odometry.md); LiDAR-only keeps sigma / 3, which its standing start needs")                         \
+        "(docs/fusion.md, stop 26); LiDAR-only keeps sigma / 3, which its standing start needs")                  \
   FIELD(double, damping, 1e-9, range::non_negative_up_to(kMaxRatio), "lambda added to the diagonal of H")         \
   FIELD(double, covariance_scale, 0.05, range::positive_up_to(kMaxRatio),                                         \
         "pose covariance = covariance_scale * H^-1 (H in the factors' normalised units; docs/fusion.md measures " \
