@@ -5,6 +5,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <cmath>
 #include <random>
 
 #include "farlio/core/config.hpp"
@@ -67,7 +68,7 @@ TEST(Degeneracy, APlaneLeavesItsInPlaneDirectionsAndNormalRotationFree) {
   RegistrationConfig config;
   const Mat6d C = registration::covariance_from_information(registration::body_information(H, SE3(), 1e-3));
   EXPECT_TRUE(C.allFinite());
-  const registration::Degeneracy d = registration::analyze_degeneracy(C, config);
+  const registration::Degeneracy d = registration::analyze_degeneracy(C, 121.0, config);
   EXPECT_EQ(d.degenerate_translations, 2);                          // x and y
   EXPECT_EQ(d.degenerate_rotations, 1);                             // yaw
   EXPECT_NEAR(std::abs(d.translation_axes.col(2).z()), 1.0, 1e-9);  // the best-constrained: the normal
@@ -78,7 +79,10 @@ TEST(Degeneracy, APlaneLeavesItsInPlaneDirectionsAndNormalRotationFree) {
 
 /// The information of a corridor along x (two walls y = +-w, floor z = 0, ceiling z = h):
 /// constrains everything but the translation along x, plus a weak along-track term `weak`.
-Mat6d corridor_information(double weak) {
+/// `end_walls`: two walls x = +-20 (40 points) close it: a room, nothing degenerate. Without them
+/// it has kCorridorFactors points.
+constexpr double kCorridorFactors = 41.0 * 5.0 * 4.0;
+Mat6d corridor_information(double weak, bool end_walls = false) {
   Mat6d H = Mat6d::Zero();
   const auto add = [&H](const Eigen::Vector3d& n, const Eigen::Vector3d& p) {
     Eigen::Matrix<double, 1, 6> J;
@@ -93,6 +97,14 @@ Mat6d corridor_information(double weak) {
       add(-Eigen::Vector3d::UnitZ(), {x, 2.0 * s, 5.0});
     }
   }
+  if (end_walls) {
+    for (double y = -4.0; y <= 4.0; y += 2.0) {
+      for (double z = 1.0; z <= 4.0; z += 1.0) {
+        add(Eigen::Vector3d::UnitX(), {20.0, y, z});
+        add(-Eigen::Vector3d::UnitX(), {-20.0, y, z});
+      }
+    }
+  }
   H(0, 0) += weak;
   return H;
 }
@@ -102,8 +114,8 @@ TEST(Degeneracy, TheStepHoldsADegenerateDirectionAndSolvesTheOthers) {
   const double scale = 0.05;
   for (const double weak : {0.0, 1e-3, 1e-1}) {  // none, and a weak fake along-track constraint
     const Mat6d H = corridor_information(weak);
-    const registration::Degeneracy d =
-        registration::analyze_degeneracy(registration::covariance_from_information(H / scale), config);
+    const registration::Degeneracy d = registration::analyze_degeneracy(
+        registration::covariance_from_information(H / scale), kCorridorFactors, config);
     ASSERT_EQ(d.degenerate_translations, 1) << weak;
     ASSERT_EQ(d.degenerate_rotations, 0) << weak;
     EXPECT_NEAR(std::abs(d.translation_axes.col(0).x()), 1.0, 1e-9);
@@ -118,6 +130,33 @@ TEST(Degeneracy, TheStepHoldsADegenerateDirectionAndSolvesTheOthers) {
   }
 }
 
+// The per-point std (degenerate_translation_point_std_m): a room seen by few points is loose in
+// every direction without being degenerate in any (its std per point is 1.04 m); a corridor's axis
+// stays degenerate however many points see it. Without the per-point limit the std alone flags the
+// sparse room.
+TEST(Degeneracy, ASparseRoomIsLooseButNotDegenerateAndACorridorIsDegenerateAtAnyDensity) {
+  const double scale = 0.05;
+  constexpr double kRoomFactors = kCorridorFactors + 40.0;  // + the end walls
+  const Mat6d room_per_point = corridor_information(0.0, true) / kRoomFactors;
+  const Mat6d corridor_per_point = corridor_information(1e-3) / kCorridorFactors;
+  for (const double point_std_m : {0.0, 2.5}) {
+    RegistrationConfig config;
+    config.degenerate_translation_point_std_m = point_std_m;
+    for (const double points : {100.0, 2000.0}) {
+      const registration::Degeneracy r = registration::analyze_degeneracy(
+          registration::covariance_from_information(points * room_per_point / scale), points, config);
+      const bool loose = r.translation_std_m(0) > config.degenerate_translation_std_m;
+      ASSERT_EQ(loose, points < 1000.0) << "the sparse room is loose by its std, the dense one is not";
+      ASSERT_LT(r.translation_std_m(0) * std::sqrt(points), 2.5);
+      EXPECT_EQ(r.degenerate_translations, loose && point_std_m == 0.0 ? 1 : 0) << points << " " << point_std_m;
+      const registration::Degeneracy c = registration::analyze_degeneracy(
+          registration::covariance_from_information(points * corridor_per_point / scale), points, config);
+      EXPECT_EQ(c.degenerate_translations, 1) << points << " " << point_std_m;
+      EXPECT_NEAR(std::abs(c.translation_axes.col(0).x()), 1.0, 1e-9);
+    }
+  }
+}
+
 TEST(Degeneracy, WithoutDegenerateDirectionsTheStepIsThePlainSolve) {
   Mat6d A = Mat6d::Random();
   const Mat6d H = A * A.transpose() + 100.0 * Mat6d::Identity();
@@ -129,7 +168,7 @@ TEST(Degeneracy, WithoutDegenerateDirectionsTheStepIsThePlainSolve) {
 TEST(Degeneracy, ReleasedDirectionsBecomeUnconstrainedAndTheRestIsKept) {
   RegistrationConfig config;
   const Mat6d C = registration::covariance_from_information(corridor_information(1e-3) / 0.05);
-  const registration::Degeneracy d = registration::analyze_degeneracy(C, config);
+  const registration::Degeneracy d = registration::analyze_degeneracy(C, kCorridorFactors, config);
   const Mat6d released = registration::release_degenerate_directions(C, d);
   EXPECT_GT(released(0, 0), 0.99 * registration::kUnconstrainedStd * registration::kUnconstrainedStd);
   EXPECT_LT((released.bottomRightCorner<5, 5>() - C.bottomRightCorner<5, 5>()).norm(), 1e-9);

@@ -21,7 +21,7 @@ from farlio.simulation import generate
 # (profile, seconds, mode, scan-pose APE RMSE bound m, KITTI-style RPE bound %, 100 Hz odometry
 # APE bound m). Measured with a fixed 20 ms latency (seed 1), bounds ~3x above:
 #   urban 10 s     LIO: APE 0.006 m, RPE 0.05 %, odometry APE 0.007 m; LiDAR-only: 0.008 m, 0.07 %
-#   handheld 25 s  LIO: APE 0.011 m, RPE 0.12 %, odometry APE 0.013 m; LiDAR-only: 0.092 m, 1.9 %
+#   handheld 25 s  LIO: APE 0.009 m, RPE 0.14 %, odometry APE 0.012 m; LiDAR-only: 0.092 m, 1.9 %
 #   (these two: scripts/measure_accuracy.py, stop 26)
 #   racetrack 6 s  LIO: APE 0.034 m, RPE 0.20 %, odometry APE 0.038 m; LiDAR-only: 0.051 m, 0.35 %
 #                  (standing start, launch to 12 m/s: the case of docs/odometry.md "racetrack launch")

@@ -217,7 +217,8 @@ void FusionDriver::link(const Scan& scan, OdometryFrame& frame) {
   if (frame.scan.registered && frame.scan.registration.system.inliers > 0) {
     covariance = registration::covariance_from_information(registration::body_information(
         frame.scan.registration.system.H, T_imu_lidar_, registration_config_.covariance_scale));
-    frame.degeneracy = registration::analyze_degeneracy(*covariance, registration_config_);
+    frame.degeneracy = registration::analyze_degeneracy(
+        *covariance, static_cast<double>(frame.scan.registration.system.inliers), registration_config_);
     // the registration held these at the fusion's prior: the scan says nothing there
     if (registration_config_.hold_degenerate_directions && frame.guess_from_fusion) {
       covariance = registration::release_degenerate_directions(*covariance, *frame.degeneracy);

@@ -45,7 +45,7 @@ Mat6d covariance_from_information(const Mat6d& information) {
   return es.eigenvectors() * inverse.asDiagonal() * es.eigenvectors().transpose();
 }
 
-Degeneracy analyze_degeneracy(const Mat6d& covariance, const RegistrationConfig& config) {
+Degeneracy analyze_degeneracy(const Mat6d& covariance, double inliers, const RegistrationConfig& config) {
   const Principal t = principal_stds(covariance.topLeftCorner<3, 3>());
   const Principal r = principal_stds(covariance.bottomRightCorner<3, 3>());
   Degeneracy d;
@@ -53,7 +53,10 @@ Degeneracy analyze_degeneracy(const Mat6d& covariance, const RegistrationConfig&
   d.translation_axes = t.axes;
   d.rotation_std_rad = r.std;
   d.rotation_axes = r.axes;
-  d.degenerate_translations = count_over(t.std, config.degenerate_translation_std_m);
+  // both the std and the std per matched point: a scan with few points (a small room) is loose
+  // everywhere without being degenerate along any direction
+  const double point_std_limit_m = config.degenerate_translation_point_std_m / std::sqrt(std::max(1.0, inliers));
+  d.degenerate_translations = count_over(t.std, std::max(config.degenerate_translation_std_m, point_std_limit_m));
   d.degenerate_rotations = count_over(r.std, config.degenerate_rotation_std_rad);
   return d;
 }

@@ -36,8 +36,9 @@ struct Degeneracy {
 };
 
 /// The principal stds of the marginal covariance blocks of `covariance` ([t; r], any frame: the
-/// axes are in the covariance's frame).
-Degeneracy analyze_degeneracy(const Mat6d& covariance, const RegistrationConfig& config);
+/// axes are in the covariance's frame). `inliers`: the correspondences of the system the
+/// covariance comes from (the per-point std of degenerate_translation_point_std_m).
+Degeneracy analyze_degeneracy(const Mat6d& covariance, double inliers, const RegistrationConfig& config);
 
 /// The directions of `d` over their thresholds as unit columns of a 6 x m matrix ([t; r]).
 Eigen::Matrix<double, 6, Eigen::Dynamic> degenerate_directions(const Degeneracy& d);

@@ -106,7 +106,8 @@ RegistrationResult gauss_newton(const SystemBuilder& build, const SE3& initial_g
     const Mat6d H = res.system.H + config.damping * Mat6d::Identity();
     Degeneracy degeneracy;  // none unless held
     if (config.hold_degenerate_directions) {
-      degeneracy = analyze_degeneracy(covariance_from_information(H / config.covariance_scale), config);
+      degeneracy = analyze_degeneracy(covariance_from_information(H / config.covariance_scale),
+                                      static_cast<double>(res.system.inliers), config);
     }
     res.held_directions = degeneracy.degenerate_translations + degeneracy.degenerate_rotations;
     const Vec6d dx = step_without_degenerate_directions(H, res.system.b, degeneracy);
