@@ -146,9 +146,11 @@ inline constexpr double kMaxThreads = 1024.0;
         "pose covariance = covariance_scale * H^-1 (H in the factors' normalised units; docs/fusion.md measures " \
         "1e-3..2e-3 on consecutive scans and inflates it for errors shared through the map)")                     \
   FIELD(double, degenerate_translation_std_m, 0.05, range::positive_up_to(kMaxSiValue),                           \
-        "a body-frame direction whose translation std (from covariance_scale * H^-1) exceeds this is degenerate") \
+        "a body-frame direction whose translation std (from covariance_scale * H^-1) exceeds this, and its "      \
+        "std per point degenerate_translation_point_std_m, is degenerate")                                        \
   FIELD(double, degenerate_translation_point_std_m, 2.5, range::non_negative_up_to(kMaxSiValue),                  \
-        "...and whose std times sqrt(inliers) also exceeds this (the std per matched point: how loosely the "     \
+        "a direction over degenerate_translation_std_m is degenerate only if its std times sqrt(inliers) also "   \
+        "exceeds this (the std per matched point: how loosely the "                                               \
         "scene's geometry holds the direction, whatever the number of points; 0: the std alone decides)")         \
   FIELD(double, degenerate_rotation_std_rad, 0.01, range::positive_up_to(kMaxSiValue),                            \
         "a body-frame axis whose rotation std exceeds this is degenerate")                                        \
