@@ -83,15 +83,33 @@ const std::vector<std::int32_t>& CellDownsampler::first_of_each_cell(const std::
   return first_of_each_cell(n, executor, [keys](std::size_t i) { return keys[i]; });
 }
 
+void CellDownsampler::Block::sort_cells() {
+  cells.clear();
+  table.drain(cells);
+  radix_sort_by_key(cells, scratch);
+}
+
 const std::vector<std::int32_t>& CellDownsampler::merge_blocks(std::size_t blocks) {
-  // 2. the blocks' cells one block after the other, sorted by key (stable: of a cell in several
-  //    blocks, the lowest block, with the lowest index, comes first), the first of each key kept
-  cells_.clear();
-  for (std::size_t b = 0; b < blocks; ++b) tables_[b].drain(cells_);
-  radix_sort_by_key(cells_, scratch_);
+  // 2. the blocks' sorted cells merged by key; of a cell in several blocks the lowest block's
+  //    entry is kept: blocks are consecutive parts of the scan, so it has the lowest index
+  heads_.assign(blocks, 0);
   kept_.clear();
-  for (std::size_t c = 0; c < cells_.size(); ++c) {
-    if (c == 0 || cells_[c].first != cells_[c - 1].first) kept_.push_back(cells_[c].second);
+  for (;;) {
+    std::size_t lowest = blocks;
+    std::uint64_t key = 0;
+    for (std::size_t b = 0; b < blocks; ++b) {
+      const auto& cells = blocks_[b].cells;
+      if (heads_[b] < cells.size() && (lowest == blocks || cells[heads_[b]].first < key)) {
+        lowest = b;
+        key = cells[heads_[b]].first;
+      }
+    }
+    if (lowest == blocks) break;
+    kept_.push_back(blocks_[lowest].cells[heads_[lowest]].second);
+    for (std::size_t b = lowest; b < blocks; ++b) {
+      const auto& cells = blocks_[b].cells;
+      if (heads_[b] < cells.size() && cells[heads_[b]].first == key) ++heads_[b];
+    }
   }
   expected_cells_ = kept_.size();
   return kept_;

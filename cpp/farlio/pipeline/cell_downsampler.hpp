@@ -4,8 +4,8 @@
 // points falls into ~10k cells of the map spacing; sorting the points by cell cost more than all
 // the other preprocessing (docs/performance.md). Each thread deduplicates a contiguous block of
 // the scan into its own table (no atomics, no cache line shared between cores), skipping a point
-// whose neighbour in the scan order fell into the same cell; the blocks' cells are then sorted
-// together by key and the first of each cell kept.
+// whose neighbour in the scan order fell into the same cell, and sorts its cells by key; the
+// blocks' sorted cells are then merged and the first of each cell kept.
 #include <algorithm>
 #include <array>
 #include <cstddef>
@@ -50,24 +50,34 @@ class CellDownsampler {
   template <typename KeyOf>
   const std::vector<std::int32_t>& first_of_each_cell(std::size_t n, exec::CpuExecutor& executor, const KeyOf& key_of) {
     const auto blocks = static_cast<std::size_t>(std::max(1, executor.num_threads()));
-    tables_.resize(blocks);
-    // each block of the scan into its own table (a task per block, one thread each)
+    blocks_.resize(blocks);
+    // each block of the scan into its own table, its cells then sorted by key (a task per block,
+    // one thread each)
     executor.for_each(
         blocks,
         [&](std::size_t b) {
-          CellTable& table = tables_[b];
-          table.reset(expected_cells_);
+          Block& block = blocks_[b];
+          block.table.reset(expected_cells_);
           // a key in `recent` is in the table with a lower index of this block: nothing to do
           std::array<std::uint64_t, kRecentCells> recent;
           recent.fill(map::kEmptyKey);
-          for (std::size_t i = b * n / blocks; i < (b + 1) * n / blocks; ++i) {
-            const std::uint64_t key = key_of(i);
-            if (key == map::kEmptyKey) continue;
-            std::uint64_t& slot = recent[map::packed_key_slot(key, kRecentCells - 1)];
-            if (slot == key) continue;
-            slot = key;
-            table.insert_min(key, static_cast<std::int32_t>(i));
+          // the bounds in locals: computed in the loop's condition, they cost a 64-bit division
+          // per point (the table's stores might alias `blocks`)
+          const std::size_t begin = b * n / blocks, end = (b + 1) * n / blocks;
+          std::uint64_t keys[kKeyBatch];
+          for (std::size_t i0 = begin; i0 < end; i0 += kKeyBatch) {
+            const std::size_t len = std::min(kKeyBatch, end - i0);
+            for (std::size_t j = 0; j < len; ++j) keys[j] = key_of(i0 + j);
+            for (std::size_t j = 0; j < len; ++j) {
+              const std::uint64_t key = keys[j];
+              if (key == map::kEmptyKey) continue;
+              std::uint64_t& slot = recent[map::packed_key_slot(key, kRecentCells - 1)];
+              if (slot == key) continue;
+              slot = key;
+              block.table.insert_min(key, static_cast<std::int32_t>(i0 + j));
+            }
           }
+          block.sort_cells();
         },
         1);
     return merge_blocks(blocks);
@@ -78,12 +88,22 @@ class CellDownsampler {
   /// A scan visits a cell again within a few dozen points (the next column of a spinning LiDAR,
   /// the next point of a ring), so most repeats are caught there instead of by a table probe.
   static constexpr std::size_t kRecentCells = 512;
+  /// Points whose keys are computed in one loop before they are looked up.
+  static constexpr std::size_t kKeyBatch = 64;
 
-  /// The blocks' cells (lowest index per cell) in key order: their indices.
+  /// One block of the scan: its cells and their lowest indices, then the same sorted by key.
+  struct Block {
+    CellTable table;
+    std::vector<std::pair<std::uint64_t, std::int32_t>> cells, scratch;
+    /// Drains the table into `cells`, sorted by key (each key once: the table holds it once).
+    void sort_cells();
+  };
+
+  /// The blocks' cells (lowest index per cell) merged in key order: their indices.
   const std::vector<std::int32_t>& merge_blocks(std::size_t blocks);
 
-  std::vector<CellTable> tables_;  // one per block of the scan (a block per thread)
-  std::vector<std::pair<std::uint64_t, std::int32_t>> cells_, scratch_;
+  std::vector<Block> blocks_;       // one per block of the scan (a block per thread)
+  std::vector<std::size_t> heads_;  // merge position in each block's sorted cells
   std::vector<std::int32_t> kept_;
   std::size_t expected_cells_ = 0;  // cells of the previous call: sizes the tables
 };

@@ -19,6 +19,10 @@ double point_to_point_precision(const RegistrationConfig& config, double covaria
 
 SourceCloud source_from_map(const map::ConstMapView& m, std::size_t voxel_capacity) {
   SourceCloud src;
+  std::size_t points = 0;
+  for (std::size_t v = 0; v < voxel_capacity; ++v) points += static_cast<std::size_t>(m.voxel_counts[v]);
+  src.points.reserve(points);
+  src.covs.reserve(points);
   for (std::size_t v = 0; v < voxel_capacity; ++v) {
     const auto vox = static_cast<std::int32_t>(v);
     for (std::int32_t j = 0; j < m.voxel_counts[v]; ++j) {
