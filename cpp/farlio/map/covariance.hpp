@@ -3,7 +3,7 @@
 // norm (paper eq. 1): Sigma = (C^-1 / ||C^-1||_F)^-1 with C = Sigma_hat + eps I, which equals
 // ||C^-1||_F * C, so no eigen-decomposition is needed. Shared by CPU and CUDA.
 #include <Eigen/Core>
-#include <Eigen/LU>
+#include <Eigen/LU>  // determinant()
 
 #include "farlio/exec/hd.hpp"
 
@@ -25,29 +25,46 @@ struct Cov3 {
 
 /// Accumulates neighbours one by one (no storage), then gives their covariance (1/k).
 /// Points are taken relative to `origin` (the query point) so that float32 keeps its precision
-/// far from the world origin.
+/// far from the world origin. Only the 6 distinct sums of the symmetric outer products are kept:
+/// the same floats as the full 3x3 sum, with 6 products a point instead of 9 (Eigen's 3x3 sum was
+/// a fifth of the covariance stage, BM_CovarianceKnn).
 struct CovarianceAccumulator {
   Eigen::Vector3f origin = Eigen::Vector3f::Zero();
-  Eigen::Vector3f sum = Eigen::Vector3f::Zero();
-  Eigen::Matrix3f sum_outer = Eigen::Matrix3f::Zero();
+  float sx = 0, sy = 0, sz = 0;                                // sum of p
+  float sxx = 0, sxy = 0, sxz = 0, syy = 0, syz = 0, szz = 0;  // sum of p p^T, upper triangle
   int count = 0;
 
   FARLIO_HD explicit CovarianceAccumulator(const Eigen::Vector3f& o) : origin(o) {}
   FARLIO_HD void add(const Eigen::Vector3f& point) {
-    const Eigen::Vector3f p = point - origin;
-    sum += p;
-    sum_outer += p * p.transpose();
+    const float x = point.x() - origin.x(), y = point.y() - origin.y(), z = point.z() - origin.z();
+    sx += x;
+    sy += y;
+    sz += z;
+    sxx += x * x;
+    sxy += x * y;
+    sxz += x * z;
+    syy += y * y;
+    syz += y * z;
+    szz += z * z;
     ++count;
   }
   FARLIO_HD Eigen::Matrix3f covariance() const {
     const float inv = 1.0f / static_cast<float>(count);
-    const Eigen::Vector3f mean = sum * inv;
-    return sum_outer * inv - mean * mean.transpose();
+    const float mx = sx * inv, my = sy * inv, mz = sz * inv;
+    const float xx = sxx * inv - mx * mx, xy = sxy * inv - mx * my, xz = sxz * inv - mx * mz;
+    const float yy = syy * inv - my * my, yz = syz * inv - my * mz, zz = szz * inv - mz * mz;
+    Eigen::Matrix3f c;
+    c << xx, xy, xz, xy, yy, yz, xz, yz, zz;
+    return c;
   }
 };
 
-/// Eigenvalues of a symmetric 3x3 matrix in ascending order, in closed form (trigonometric
-/// solution of the characteristic cubic): no iteration, so it runs the same on CPU and GPU.
+/// Eigenvalues of a symmetric 3x3 matrix in ascending order, in closed form without iteration
+/// or trigonometry, so it runs the same on CPU and GPU. The trigonometric solution of the
+/// characteristic cubic gives the smallest as q - 2 p cos(u) with cos(3u) = -r; c = cos(u) in
+/// [1/2, 1] is written 1/2 + s, and s solves 4 s^3 + 6 s^2 = 1 - r, which Newton's method reaches
+/// from above in three steps starting at sqrt((1 - r) / 6) (the cubic is convex there). acosf and
+/// two cosf cost more than the rest of the shape test (stop 27, BM_CovarianceKnn).
 FARLIO_HD inline Eigen::Vector3f symmetric_eigenvalues(const Eigen::Matrix3f& a) {
   const float off2 = a(0, 1) * a(0, 1) + a(0, 2) * a(0, 2) + a(1, 2) * a(1, 2);
   const float q = a.trace() / 3.0f;
@@ -56,10 +73,18 @@ FARLIO_HD inline Eigen::Vector3f symmetric_eigenvalues(const Eigen::Matrix3f& a)
   if (p <= 0.0f) return Eigen::Vector3f::Constant(q);  // a multiple of the identity
   const Eigen::Matrix3f b = (a - q * Eigen::Matrix3f::Identity()) / p;
   const float r = fminf(1.0f, fmaxf(-1.0f, 0.5f * b.determinant()));
-  constexpr float kThird = 1.0f / 3.0f, kTwoPiThirds = 2.0943951f;
-  const float phi = acosf(r) * kThird;
-  const float largest = q + 2.0f * p * cosf(phi);
-  const float smallest = q + 2.0f * p * cosf(phi + kTwoPiThirds);
+  constexpr float kSixth = 1.0f / 6.0f, kSqrt3 = 1.7320508f;
+  constexpr int kNewtonSteps = 3;
+  const float t = 1.0f - r;
+  float s = sqrtf(t * kSixth);
+  for (int i = 0; i < kNewtonSteps; ++i) {
+    const float slope = 12.0f * s * (s + 1.0f);
+    if (slope > 0.0f) s -= (s * s * (4.0f * s + 6.0f) - t) / slope;
+  }
+  const float c = 0.5f + s;
+  const float sin_u = sqrtf(fmaxf(0.0f, 1.0f - c * c));
+  const float smallest = q - 2.0f * p * c;
+  const float largest = q + p * (c + kSqrt3 * sin_u);
   return {smallest, 3.0f * q - largest - smallest, largest};
 }
 
@@ -80,13 +105,16 @@ FARLIO_HD inline PointShape classify_shape(const Eigen::Matrix3f& regularized_co
   return line ? PointShape::Line : PointShape::Surface;
 }
 
-/// Frobenius-norm regularisation of eq. (1).
+/// Frobenius-norm regularisation of eq. (1): ||C^-1||_F from C's cofactors, ||adj C||_F / |det C|
+/// (C is symmetric, so 6 distinct cofactors), without forming the inverse.
 FARLIO_HD inline Eigen::Matrix3f regularize_frobenius(const Eigen::Matrix3f& sample_cov, float epsilon) {
   const Eigen::Matrix3f c = sample_cov + epsilon * Eigen::Matrix3f::Identity();
-  // The inverse into a matrix first: Eigen 3.4's norm() of the inverse expression compiles to a
-  // trap in device code (seen on an H200: every covariance kernel stopped there).
-  const Eigen::Matrix3f inverse = c.inverse();
-  return inverse.norm() * c;
+  const float a = c(0, 0), b = c(0, 1), d = c(0, 2), e = c(1, 1), f = c(1, 2), g = c(2, 2);
+  const float c00 = e * g - f * f, c01 = d * f - b * g, c02 = b * f - d * e;
+  const float c11 = a * g - d * d, c12 = b * d - a * f, c22 = a * e - b * b;
+  const float det = a * c00 + b * c01 + d * c02;
+  const float adjugate2 = c00 * c00 + c11 * c11 + c22 * c22 + 2.0f * (c01 * c01 + c02 * c02 + c12 * c12);
+  return (sqrtf(adjugate2) / fabsf(det)) * c;
 }
 
 }  // namespace farlio::map

@@ -168,23 +168,32 @@ FARLIO_HD int knn_over(const ConstMapView& m, const Walk& walk, const Eigen::Vec
          walked[voxels++] = v;
          const std::int32_t n = m.voxel_counts[v];
          const std::int64_t first = m.point_index(v, 0);
+         // the bound and the count in locals over the voxel: captured by reference, they were
+         // loaded and stored around every candidate (the list's stores might alias them)
+         float voxel_bound = bound;
+         int voxel_found = found;
+         const int kk = k;
          // distances of a block of points first, then the few that pass the bound are inserted
          for (std::int32_t j0 = 0; j0 < n; j0 += kDistanceBlock) {
            float block[kDistanceBlock];
            const std::int32_t len = block_distances2(m, first + j0, n - j0, query, block);
            for (std::int32_t j = 0; j < len; ++j) {
-             if (!(block[j] < bound)) continue;
+             if (!(block[j] < voxel_bound)) continue;
              const std::uint64_t key = (static_cast<std::uint64_t>(exec::float_bits(block[j])) << 32) |
                                        (rank << kSlotBits) | static_cast<std::uint64_t>(j0 + j);
-             int pos = found < k ? found++ : k - 1;
+             int pos = voxel_found < kk ? voxel_found++ : kk - 1;
              while (pos > 0 && best[pos - 1] > key) {
                best[pos] = best[pos - 1];
                --pos;
              }
              best[pos] = key;
-             if (found == k) bound = exec::float_from_bits(static_cast<std::uint32_t>(best[k - 1] >> 32));
+             if (voxel_found == kk) {
+               voxel_bound = exec::float_from_bits(static_cast<std::uint32_t>(best[kk - 1] >> 32));
+             }
            }
          }
+         bound = voxel_bound;
+         found = voxel_found;
        });
   constexpr std::uint64_t kSlotMask = (std::uint64_t{1} << kSlotBits) - 1;
   for (int s = 0; s < found; ++s) {
