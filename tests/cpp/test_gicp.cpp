@@ -2,7 +2,9 @@
 // the time budget, and the adaptive threshold.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <limits>
+#include <random>
 
 #include "farlio/map/voxel_map.hpp"
 #include "farlio/registration/adaptive_threshold.hpp"
@@ -177,6 +179,59 @@ TEST(Gicp, PointToPointFallbackWithoutCovariance) {
   ASSERT_TRUE(gicp_factor(target.view(), with_cov, c, fp, f_cov_again));
   for (int k = 0; k < 21; ++k) EXPECT_NEAR(f_scaled.H[k], 0.03f * f_p2p.H[k], 1e-5f * (1.0f + std::abs(f_p2p.H[k])));
   for (int k = 0; k < 21; ++k) EXPECT_FLOAT_EQ(f_cov_again.H[k], f_cov.H[k]);
+}
+
+TEST(Gicp, FactorEqualsTheProductOfItsJacobianAndInformation) {
+  // gicp_factor_at forms H and b from A = R^T Omega R without J; the reference forms
+  // J = [R, -R [s]x], Omega = (C_q + R C_s R^T)^-1 and w J^T Omega J, w J^T Omega r in double.
+  exec::CpuExecutor ex(1);
+  map::VoxelMap target(VoxelMapConfig{}, ex);
+  target.insert(test::sample_scene(60000, 3), Eigen::Vector3f::Zero(), map::PointLimit::constant(40));
+  const map::ConstMapView view = target.view();
+  std::mt19937 rng(11);
+  std::normal_distribution<float> g(0.0f, 1.0f);
+  int compared = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const Eigen::Vector3f axis = Eigen::Vector3f(g(rng), g(rng), g(rng)).normalized();
+    const Eigen::Matrix3f R = Eigen::AngleAxisf(0.3f * g(rng), axis).toRotationMatrix();
+    const Eigen::Vector3f t(0.1f * g(rng), 0.1f * g(rng), 0.05f * g(rng));
+    const Eigen::Vector3f sp(15.0f * g(rng), 15.0f * g(rng), 0.5f * std::abs(g(rng)));
+    Eigen::Matrix3f a;
+    for (int i = 0; i < 9; ++i) a.data()[i] = 0.1f * g(rng);
+    const Eigen::Matrix3f cs = a * a.transpose() + 1e-3f * Eigen::Matrix3f::Identity();
+    const bool point_to_point = trial % 4 == 0;
+    const Eigen::Vector4f s(sp.x(), sp.y(), sp.z(),
+                            map::shape_code(point_to_point ? map::PointShape::NoCovariance : map::PointShape::Surface));
+    FactorParams fp{R, t, 4.0f, CauchyKernel{0.5f}, true};
+    fp.point_to_point_precision = 2.5f;
+    const Eigen::Vector3f p = R * sp + t;
+    const std::int64_t nn = map::nearest_neighbor(view, p, fp.max_correspondence_distance2);
+    FactorTerms f{};
+    if (!gicp_factor_at(view, s, map::Cov3::from(cs), p, nn, fp, f)) continue;
+    const Eigen::Vector4f& q = view.points[nn];
+    const Eigen::Matrix3d Rd = R.cast<double>();
+    Eigen::Matrix3d omega = fp.point_to_point_precision * Eigen::Matrix3d::Identity();
+    if (map::has_covariance(s) && map::has_covariance(q)) {
+      omega = (view.covs[nn].matrix().cast<double>() + Rd * cs.cast<double>() * Rd.transpose()).inverse();
+    }
+    const Eigen::Vector3d sd = sp.cast<double>();
+    Eigen::Matrix3d sx;
+    sx << 0.0, -sd.z(), sd.y(), sd.z(), 0.0, -sd.x(), -sd.y(), sd.x(), 0.0;
+    Eigen::Matrix<double, 3, 6> J;
+    J << Rd, -Rd * sx;
+    const Eigen::Vector3d r = (p - q.head<3>()).cast<double>();
+    const double w = fp.kernel.weight(static_cast<float>(r.squaredNorm()));
+    const Eigen::Matrix<double, 6, 6> H = w * J.transpose() * omega * J;
+    const Eigen::Matrix<double, 6, 1> b = w * J.transpose() * omega * r;
+    const double h_scale = H.cwiseAbs().maxCoeff(), b_scale = b.cwiseAbs().maxCoeff() + 1e-12;
+    int k = 0;
+    for (int i = 0; i < 6; ++i) {
+      for (int j = i; j < 6; ++j) EXPECT_NEAR(f.H[k++], H(i, j), 2e-5 * h_scale) << "H(" << i << "," << j << ")";
+      EXPECT_NEAR(f.b[i], b(i), 2e-5 * b_scale) << "b(" << i << ")";
+    }
+    ++compared;
+  }
+  EXPECT_GE(compared, 100);
 }
 
 TEST(Gicp, PointToPointPrecisionFollowsTheSpacing) {

@@ -39,40 +39,66 @@ struct FactorParams {
   float point_to_point_precision = 1.0f;  ///< lambda, in the Frobenius-normalised units of Omega
 };
 
+/// C^-1 of a symmetric 3x3 matrix from its cofactors (C = C^T, so 6 of them).
+FARLIO_HD inline Eigen::Matrix3f symmetric_inverse(const Eigen::Matrix3f& c) {
+  const float a = c(0, 0), b = c(0, 1), d = c(0, 2), e = c(1, 1), f = c(1, 2), g = c(2, 2);
+  const float c00 = e * g - f * f, c01 = d * f - b * g, c02 = b * f - d * e;
+  const float c11 = a * g - d * d, c12 = b * d - a * f, c22 = a * e - b * b;
+  const float inv_det = 1.0f / (a * c00 + b * c01 + d * c02);
+  Eigen::Matrix3f inv;
+  inv << c00, c01, c02, c01, c11, c12, c02, c12, c22;
+  return inv * inv_det;
+}
+
 /// The factor of source point `s` (w = 1 if `cov_s` is valid) at its transformed position
 /// p = R s + t, matched to map point `nn` (-1: none). Returns false (and leaves `out` untouched)
 /// when there is no correspondence within the distance.
+///
+/// With J = R [I, -[s]x] the blocks of J^T Omega J need only A = R^T Omega R, which for GICP is
+/// (R^T C_q R + C_s)^-1: H = w [A, -A S; S A, -S A S] and b = w [A r'; s x (A r')] with S = [s]x
+/// and r' = R^T r, about half the arithmetic of forming J and the 6x6 product (stop 27;
+/// tests/cpp/test_gicp.cpp checks it against that product).
 FARLIO_HD inline bool gicp_factor_at(const map::ConstMapView& m, const Eigen::Vector4f& s, const map::Cov3& cov_s,
                                      const Eigen::Vector3f& p, std::int64_t nn, const FactorParams& fp,
                                      FactorTerms& out) {
   if (nn < 0) return false;
-  const Eigen::Vector3f sp = s.head<3>();
   const Eigen::Vector4f& q = m.points[nn];
   const Eigen::Vector3f r = p - q.head<3>();
   const float r2 = r.squaredNorm();
   if (!(r2 <= fp.max_correspondence_distance2)) return false;  // a reused match that moved out of the gate
-  Eigen::Matrix3f omega = Eigen::Matrix3f::Identity();
   const bool both_covariances = map::has_covariance(s) && map::has_covariance(q);
   if (fp.sparsity_aware && fp.skip_line_pairs && map::is_line_like(s) && map::is_line_like(q)) return false;
-  if (fp.sparsity_aware) omega *= fp.point_to_point_precision;
+  // A = R^T Omega R: Omega = I (plain ICP), lambda I (point-to-point), (C_q + R C_s R^T)^-1 (GICP)
+  Eigen::Matrix3f A = Eigen::Matrix3f::Identity();
+  if (fp.sparsity_aware) A *= fp.point_to_point_precision;
   if (fp.sparsity_aware && both_covariances) {
-    const Eigen::Matrix3f c = m.covs[nn].matrix() + fp.R * cov_s.matrix() * fp.R.transpose();
-    const Eigen::Matrix3f inv = c.inverse();
-    if (exec::all_finite(inv)) omega = inv;
+    const Eigen::Matrix3f c = fp.R.transpose() * m.covs[nn].matrix() * fp.R + cov_s.matrix();
+    const Eigen::Matrix3f inv = symmetric_inverse(c);
+    if (exec::all_finite(inv)) A = inv;
   }
   const float w = fp.kernel.weight(r2);
-  Eigen::Matrix<float, 3, 6> J;
-  J.leftCols<3>() = fp.R;
-  Eigen::Matrix3f sx;
-  sx << 0.0f, -sp.z(), sp.y(), sp.z(), 0.0f, -sp.x(), -sp.y(), sp.x(), 0.0f;
-  J.rightCols<3>() = -fp.R * sx;
-  const Eigen::Matrix<float, 6, 3> JtW = w * (J.transpose() * omega);
-  const Eigen::Matrix<float, 6, 6> H = JtW * J;
-  const Eigen::Matrix<float, 6, 1> b = JtW * r;
+  const float x = s.x(), y = s.y(), z = s.z();
+  // B = A S, column by column (S's columns: (0, z, -y), (-z, 0, x), (y, -x, 0))
+  Eigen::Matrix3f B;
+  B.col(0) = z * A.col(1) - y * A.col(2);
+  B.col(1) = x * A.col(2) - z * A.col(0);
+  B.col(2) = y * A.col(0) - x * A.col(1);
+  // S B, row by row (S's rows: (0, -z, y), (z, 0, -x), (-y, x, 0)); H_rr = -S B
+  Eigen::Matrix3f SB;
+  SB.row(0) = y * B.row(2) - z * B.row(1);
+  SB.row(1) = z * B.row(0) - x * B.row(2);
+  SB.row(2) = x * B.row(1) - y * B.row(0);
+  const Eigen::Vector3f v = A * (fp.R.transpose() * r);
+  const Eigen::Vector3f sv = s.head<3>().cross(v);
   int k = 0;
-  for (int i = 0; i < 6; ++i) {
-    for (int j = i; j < 6; ++j) out.H[k++] = H(i, j);
-    out.b[i] = b(i);
+  for (int i = 0; i < 3; ++i) {
+    for (int j = i; j < 3; ++j) out.H[k++] = w * A(i, j);
+    for (int j = 0; j < 3; ++j) out.H[k++] = -w * B(i, j);
+    out.b[i] = w * v(i);
+  }
+  for (int i = 0; i < 3; ++i) {
+    for (int j = i; j < 3; ++j) out.H[k++] = -w * SB(i, j);
+    out.b[3 + i] = w * sv(i);
   }
   out.cost = fp.kernel.cost(r2);
   out.inlier = 1;
