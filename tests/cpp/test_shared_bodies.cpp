@@ -178,10 +178,15 @@ TEST(SharedBodies, BlockDistancesEqualTheBoxDistanceOfEachVoxel) {
       const Eigen::Vector3f p(u(rng), u(rng), 0.1f * u(rng));
       const map::VoxelCoord c0 = map::voxel_of(p, 1.0f / voxel);
       const map::BlockDistances box(p, c0, voxel);
+      float nearest_other = std::numeric_limits<float>::max();
       for (int n = 0; n < map::kNeighborVoxels; ++n) {
         ASSERT_EQ(box.distance2(n), voxel_box_distance2(p, map::neighbor_voxel(c0, n), voxel)) << n;
+        if (n > 0) nearest_other = std::min(nearest_other, box.distance2(n));
       }
       EXPECT_EQ(box.distance2(0), 0.0f);
+      // the searches stop after the centre when their bound is within the nearest face: exact,
+      // because none of the other 26 voxels is nearer
+      EXPECT_LE(box.nearest_face2(), nearest_other);
     }
   }
 }

@@ -36,7 +36,8 @@ FARLIO_HD inline std::int32_t block_distances2(const ConstMapView& m, std::int64
 inline constexpr int kNeighborVoxels = 27;
 
 /// The block position of the n-th voxel around a centre (n = 0 is the centre, the rest in a
-/// fixed order): axis a is offset by digit a of the code in base 3, minus 1.
+/// fixed order): axis a is offset by digit a of the code in base 3, minus 1. (Faces, then edges,
+/// then corners was not faster: BM_NearestNeighbor, BM_CovarianceKnn, stop 27.)
 FARLIO_HD inline int neighbor_code(int n) {
   constexpr int kCentreCode = 13;
   return n == 0 ? kCentreCode : (n <= kCentreCode ? n - 1 : n);
@@ -62,6 +63,17 @@ struct BlockDistances {
       }
     }
   }
+  /// Squared distance from p to the nearest face of the centre voxel: no other voxel of the
+  /// block is nearer (each is beyond at least one face), so a search whose bound is already this
+  /// small has nothing left to visit after the centre.
+  [[nodiscard]] FARLIO_HD float nearest_face2() const {
+    float d = along[0][0];
+    for (int a = 0; a < 3; ++a) {
+      d = fminf(d, along[a][0]);
+      d = fminf(d, along[a][2]);
+    }
+    return d * d;
+  }
   /// Squared distance from p to the box of the n-th voxel of the block.
   [[nodiscard]] FARLIO_HD float distance2(int n) const {
     const int code = neighbor_code(n);
@@ -82,8 +94,11 @@ FARLIO_HD void for_each_nearby_voxel(const ConstMapView& m, const Eigen::Vector3
                                      const Visit& visit) {
   const VoxelCoord c0 = voxel_of(p, m.inv_voxel_size);
   const BlockDistances box(p, c0, m.voxel_size);
-  for (int n = 0; n < kNeighborVoxels; ++n) {
-    if (n > 0 && box.distance2(n) >= bound2()) continue;
+  const std::int32_t centre = table_find(m, c0);
+  if (centre >= 0) visit(centre);
+  if (bound2() <= box.nearest_face2()) return;  // no other voxel can be nearer
+  for (int n = 1; n < kNeighborVoxels; ++n) {
+    if (box.distance2(n) >= bound2()) continue;
     const std::int32_t v = table_find(m, neighbor_voxel(c0, n));
     if (v >= 0) visit(v);
   }
@@ -109,9 +124,11 @@ template <typename Visit, typename Bound>
 FARLIO_HD void for_each_nearby_voxel(const ConstMapView& m, const VoxelNeighborhood& nb, const Eigen::Vector3f& p,
                                      const Bound& bound2, const Visit& visit) {
   const BlockDistances box(p, nb.centre, m.voxel_size);
-  for (int n = 0; n < kNeighborVoxels; ++n) {
+  if (nb.voxels[0] >= 0) visit(nb.voxels[0]);
+  if (bound2() <= box.nearest_face2()) return;  // no other voxel can be nearer
+  for (int n = 1; n < kNeighborVoxels; ++n) {
     if (nb.voxels[n] < 0) continue;
-    if (n > 0 && box.distance2(n) >= bound2()) continue;
+    if (box.distance2(n) >= bound2()) continue;
     visit(nb.voxels[n]);
   }
 }
