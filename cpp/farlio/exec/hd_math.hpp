@@ -41,6 +41,11 @@ FARLIO_HD inline int floor_to_int(float x) {
 #endif
 }
 
+/// The smaller / larger of two floats without a NaN rule: one minss / maxss on the host, where
+/// fminf and fmaxf are calls into libm (they must return the number when the other is NaN).
+FARLIO_HD inline float min_of(float a, float b) { return a < b ? a : b; }
+FARLIO_HD inline float max_of(float a, float b) { return a > b ? a : b; }
+
 /// The bits of a float and back (memcpy: defined behaviour on the host and the device). For
 /// x >= +0 the bits order as the values do.
 FARLIO_HD inline std::uint32_t float_bits(float x) {

@@ -6,6 +6,7 @@
 #include <Eigen/LU>  // determinant()
 
 #include "farlio/exec/hd.hpp"
+#include "farlio/exec/hd_math.hpp"
 
 namespace farlio::map {
 
@@ -72,7 +73,7 @@ FARLIO_HD inline Eigen::Vector3f symmetric_eigenvalues(const Eigen::Matrix3f& a)
   const float p = sqrtf((d0 * d0 + d1 * d1 + d2 * d2 + 2.0f * off2) / 6.0f);
   if (p <= 0.0f) return Eigen::Vector3f::Constant(q);  // a multiple of the identity
   const Eigen::Matrix3f b = (a - q * Eigen::Matrix3f::Identity()) / p;
-  const float r = fminf(1.0f, fmaxf(-1.0f, 0.5f * b.determinant()));
+  const float r = exec::min_of(1.0f, exec::max_of(-1.0f, 0.5f * b.determinant()));
   constexpr float kSixth = 1.0f / 6.0f, kSqrt3 = 1.7320508f;
   constexpr int kNewtonSteps = 3;
   const float t = 1.0f - r;
@@ -82,7 +83,7 @@ FARLIO_HD inline Eigen::Vector3f symmetric_eigenvalues(const Eigen::Matrix3f& a)
     if (slope > 0.0f) s -= (s * s * (4.0f * s + 6.0f) - t) / slope;
   }
   const float c = 0.5f + s;
-  const float sin_u = sqrtf(fmaxf(0.0f, 1.0f - c * c));
+  const float sin_u = sqrtf(exec::max_of(0.0f, 1.0f - c * c));
   const float smallest = q - 2.0f * p * c;
   const float largest = q + p * (c + kSqrt3 * sin_u);
   return {smallest, 3.0f * q - largest - smallest, largest};

@@ -69,8 +69,8 @@ struct BlockDistances {
   [[nodiscard]] FARLIO_HD float nearest_face2() const {
     float d = along[0][0];
     for (int a = 0; a < 3; ++a) {
-      d = fminf(d, along[a][0]);
-      d = fminf(d, along[a][2]);
+      d = exec::min_of(d, along[a][0]);
+      d = exec::min_of(d, along[a][2]);
     }
     return d * d;
   }
