@@ -90,8 +90,7 @@ void CellDownsampler::Block::sort_cells() {
 }
 
 const std::vector<std::int32_t>& CellDownsampler::merge_blocks(std::size_t blocks) {
-  // 2. the blocks' sorted cells merged by key; of a cell in several blocks the lowest block's
-  //    entry is kept: blocks are consecutive parts of the scan, so it has the lowest index
+  // 2. the blocks' sorted cells merged by key; of a cell in several blocks the lowest index
   heads_.assign(blocks, 0);
   kept_.clear();
   for (;;) {
@@ -105,11 +104,15 @@ const std::vector<std::int32_t>& CellDownsampler::merge_blocks(std::size_t block
       }
     }
     if (lowest == blocks) break;
-    kept_.push_back(blocks_[lowest].cells[heads_[lowest]].second);
+    std::int32_t first = blocks_[lowest].cells[heads_[lowest]].second;
     for (std::size_t b = lowest; b < blocks; ++b) {
       const auto& cells = blocks_[b].cells;
-      if (heads_[b] < cells.size() && cells[heads_[b]].first == key) ++heads_[b];
+      if (heads_[b] < cells.size() && cells[heads_[b]].first == key) {
+        first = std::min(first, cells[heads_[b]].second);
+        ++heads_[b];
+      }
     }
+    kept_.push_back(first);
   }
   expected_cells_ = kept_.size();
   return kept_;
