@@ -13,6 +13,8 @@
 #include "farlio/map/neighbor_search.hpp"
 #include "farlio/map/voxel_map.hpp"
 #include "farlio/map/voxel_update.hpp"
+#include "farlio/pipeline/downsampling_keys.hpp"
+#include "farlio/pipeline/preprocess_point.hpp"
 #include "farlio/pipeline/range_crop.hpp"
 #include "farlio/registration/factor_sums.hpp"
 #include "farlio/registration/gicp.hpp"
@@ -59,6 +61,44 @@ TEST(SharedBodies, RangeCropKeepsTheClosedInterval) {
   EXPECT_FALSE(crop.keeps({0.5f, 0, 0}));
   EXPECT_FALSE(crop.keeps({0, 0, 10.5f}));
   EXPECT_FALSE(crop.keeps({std::numeric_limits<float>::infinity(), 0, 0}));
+}
+
+TEST(SharedBodies, DownsamplingKeysOfTheCpuEqualThePerPointBody) {
+  // the CPU's batch (SSE2, four points at a time) against downsampling_key, which CUDA runs:
+  // ordinary points, points on cell borders and on the crop's bounds, huge, infinite and NaN
+  // coordinates, and batch lengths that leave a scalar tail
+  const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-120.0f, 120.0f);
+  std::uniform_int_distribution<int> cell(-300, 300), pick(0, 9);
+  for (const float cell_m : {0.632f, 0.1f, 2.0f}) {
+    PreprocessConfig c;
+    c.min_range_m = 1.0;
+    c.max_range_m = 100.0;
+    pipeline::PreprocessParams pp{pipeline::RangeCrop::from(c), {}, false, 1.0f / cell_m};
+    std::vector<Vec3f> pts;
+    for (int i = 0; i < 20000; ++i) {
+      Vec3f p(u(rng), u(rng), 0.2f * u(rng));
+      switch (pick(rng)) {
+        case 0: p.x() = static_cast<float>(cell(rng)) * cell_m; break;  // on a cell border
+        case 1: p = p.normalized() * 100.0f; break;                     // on the crop's bound
+        case 2: p = p.normalized(); break;
+        case 3: p.y() = pick(rng) < 5 ? inf : -inf; break;
+        case 4: p.z() = nan; break;
+        case 5: p *= 1e18f; break;  // a squared range that overflows
+        case 6: p.x() = -0.0f; break;
+        default: break;
+      }
+      pts.push_back(p);
+    }
+    for (const std::size_t n : {pts.size(), std::size_t{7}, std::size_t{3}, std::size_t{0}}) {
+      std::vector<std::uint64_t> batch(n, 0);
+      pipeline::downsampling_keys(pts.data(), n, pp, batch.data());
+      for (std::size_t i = 0; i < n; ++i) {
+        ASSERT_EQ(batch[i], pipeline::downsampling_key(pts[i], pp)) << pts[i].transpose() << " cell " << cell_m;
+      }
+    }
+  }
 }
 
 TEST(SharedBodies, VoxelGroupInsertionKeepsOrderCapAndSpacing) {

@@ -80,7 +80,9 @@ void CellTable::drain(std::vector<std::pair<std::uint64_t, std::int32_t>>& out) 
 
 const std::vector<std::int32_t>& CellDownsampler::first_of_each_cell(const std::uint64_t* keys, std::size_t n,
                                                                      exec::CpuExecutor& executor) {
-  return first_of_each_cell(n, executor, [keys](std::size_t i) { return keys[i]; });
+  return first_of_each_cell(n, executor, [keys](std::size_t first, std::size_t count, std::uint64_t* out) {
+    std::copy(keys + first, keys + first + count, out);
+  });
 }
 
 void CellDownsampler::Block::sort_cells() {

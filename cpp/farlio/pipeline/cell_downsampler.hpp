@@ -45,10 +45,11 @@ class CellDownsampler {
   const std::vector<std::int32_t>& first_of_each_cell(const std::uint64_t* keys, std::size_t n,
                                                       exec::CpuExecutor& executor);
 
-  /// The same with the keys computed in the blocks' loop: key_of(i) is the key of point i, called
-  /// once per point (the preprocessing's per-point body, which also writes the point).
-  template <typename KeyOf>
-  const std::vector<std::int32_t>& first_of_each_cell(std::size_t n, exec::CpuExecutor& executor, const KeyOf& key_of) {
+  /// The same with the keys computed in the blocks' loop: keys_of(first, count, out) writes the
+  /// keys of points [first, first + count) to out (count <= 64), once per point.
+  template <typename KeysOf>
+  const std::vector<std::int32_t>& first_of_each_cell(std::size_t n, exec::CpuExecutor& executor,
+                                                      const KeysOf& keys_of) {
     const auto blocks = static_cast<std::size_t>(std::max(1, executor.num_threads()));
     blocks_.resize(blocks);
     // each block into its own table, its cells then sorted by key (a task per block, one
@@ -71,7 +72,7 @@ class CellDownsampler {
             const std::size_t begin = chunk * kChunkPoints, end = std::min(n, begin + kChunkPoints);
             for (std::size_t i0 = begin; i0 < end; i0 += kKeyBatch) {
               const std::size_t len = std::min(kKeyBatch, end - i0);
-              for (std::size_t j = 0; j < len; ++j) keys[j] = key_of(i0 + j);
+              keys_of(i0, len, keys);
               for (std::size_t j = 0; j < len; ++j) {
                 const std::uint64_t key = keys[j];
                 if (key == map::kEmptyKey) continue;

@@ -1,5 +1,6 @@
 #include "farlio/pipeline/cpu_scan_backend.hpp"
 
+#include "farlio/pipeline/downsampling_keys.hpp"
 #include "farlio/pipeline/preprocess_point.hpp"
 
 namespace farlio::pipeline {
@@ -22,7 +23,9 @@ std::size_t CpuScanBackend::preprocess(const Scan& scan, const deskew::ScanMotio
                             1.0f / map_.spacing_m()};
   // one pass: each thread crops its block of the scan and deduplicates its cells
   const std::vector<std::int32_t>& kept = downsampler_.first_of_each_cell(
-      scan.size(), executor_, [&](std::size_t i) { return downsampling_key(scan.points[i], pp); });
+      scan.size(), executor_, [&](std::size_t first, std::size_t count, std::uint64_t* keys) {
+        downsampling_keys(scan.points.data() + first, count, pp, keys);
+      });
   // then only the kept points are undistorted
   frame_.resize(kept.size());
   executor_.for_each(kept.size(), [&](std::size_t k) {

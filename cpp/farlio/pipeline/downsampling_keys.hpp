@@ -1,0 +1,18 @@
+#pragma once
+// The CPU's batch of downsampling_key (preprocess_point.hpp): the same keys, computed four points
+// at a time with SSE2 (x86-64's baseline) where the host has it, point by point otherwise. The
+// keys were three quarters of the preprocessing's loop, most of it the three floors per point
+// (docs/performance.md, stop 27). CUDA runs downsampling_key itself, one thread a point;
+// tests/cpp/test_shared_bodies.cpp checks that both give the same keys, bit for bit.
+#include <cstddef>
+#include <cstdint>
+
+#include "farlio/core/types.hpp"
+#include "farlio/pipeline/preprocess_point.hpp"
+
+namespace farlio::pipeline {
+
+/// keys[i] = downsampling_key(points[i], pp) for i in [0, n).
+void downsampling_keys(const Vec3f* points, std::size_t n, const PreprocessParams& pp, std::uint64_t* keys);
+
+}  // namespace farlio::pipeline
