@@ -143,15 +143,22 @@ FARLIO_HD inline std::int64_t nearest_neighbor(const ConstMapView& m, const Eige
       [&](std::int32_t v) {
         const std::int32_t n = m.voxel_counts[v];
         const std::int64_t first = m.point_index(v, 0);
+        // the best so far in locals over the voxel (as knn_over's bound): captured by reference
+        // they were loaded and stored around every point
+        float voxel_best = best;
+        std::int32_t voxel_best_slot = -1;
         for (std::int32_t j0 = 0; j0 < n; j0 += kDistanceBlock) {
           float d2[kDistanceBlock];
           const std::int32_t len = block_distances2(m, first + j0, n - j0, p, d2);
           for (std::int32_t j = 0; j < len; ++j) {
-            if (d2[j] < best) {
-              best = d2[j];
-              best_index = first + j0 + j;
-            }
+            const bool nearer = d2[j] < voxel_best;
+            voxel_best = nearer ? d2[j] : voxel_best;
+            voxel_best_slot = nearer ? j0 + j : voxel_best_slot;
           }
+        }
+        if (voxel_best_slot >= 0) {
+          best = voxel_best;
+          best_index = first + voxel_best_slot;
         }
       });
   if (distance2) *distance2 = best;

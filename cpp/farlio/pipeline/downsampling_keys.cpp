@@ -26,8 +26,8 @@ inline void four_keys(const float* xyz, const PreprocessParams& pp, std::uint64_
   // a finite squared range also means finite coordinates, map::point_key's first test
   const __m128 r2 = _mm_add_ps(_mm_mul_ps(x, x), _mm_add_ps(_mm_mul_ps(y, y), _mm_mul_ps(z, z)));
   const __m128 finite = _mm_cmplt_ps(r2, _mm_set1_ps(std::numeric_limits<float>::infinity()));
-  const __m128 in_range = _mm_and_ps(_mm_cmpge_ps(r2, _mm_set1_ps(pp.crop.min_range2)),
-                                     _mm_cmple_ps(r2, _mm_set1_ps(pp.crop.max_range2)));
+  const __m128 in_range =
+      _mm_and_ps(_mm_cmpge_ps(r2, _mm_set1_ps(pp.crop.min_range2)), _mm_cmple_ps(r2, _mm_set1_ps(pp.crop.max_range2)));
   __m128i keep = _mm_castps_si128(_mm_and_ps(finite, in_range));
   // the cell: exec::floor_to_int per axis (truncation, minus one where that rounded up), then
   // map::in_key_range and map::pack_key
