@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "farlio/exec/hd.hpp"
+#include "farlio/exec/hd_math.hpp"
 
 namespace farlio::registration {
 
@@ -12,7 +13,7 @@ struct CauchyKernel {
 
   FARLIO_HD float weight(float residual2) const { return 1.0f / (1.0f + residual2 / (kappa_m * kappa_m)); }
   FARLIO_HD float cost(float residual2) const {
-    return 0.5f * kappa_m * kappa_m * log1pf(residual2 / (kappa_m * kappa_m));
+    return 0.5f * kappa_m * kappa_m * exec::log1p_nonnegative(residual2 / (kappa_m * kappa_m));
   }
 };
 
