@@ -48,6 +48,15 @@ TEST(KeyGrouping, EqualsSortingTheKeyIndexPairs) {
     }
     expect_equals_the_sort(g, keys);
   }
+  // runs of one key, as points in the order of their downsampling cells give (a key equal to
+  // the previous index's skips the table), with a key coming back after other runs
+  std::vector<std::uint64_t> runs;
+  std::uniform_int_distribution<int> run_length(1, 12), run_key(0, 40);
+  while (runs.size() < 20000) {
+    const std::uint64_t key = run_key(rng) == 0 ? map::kEmptyKey : map::pack_key({run_key(rng), 1, 2});
+    runs.insert(runs.end(), static_cast<std::size_t>(run_length(rng)), key);
+  }
+  expect_equals_the_sort(g, runs);
   expect_equals_the_sort(g, {});
   expect_equals_the_sort(g, std::vector<std::uint64_t>(50, map::kEmptyKey));
 }

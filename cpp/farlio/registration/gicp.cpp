@@ -1,6 +1,7 @@
 #include "farlio/registration/gicp.hpp"
 
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -17,20 +18,27 @@ double point_to_point_precision(const RegistrationConfig& config, double covaria
   return sigma2 > 0.0 ? covariance_epsilon / sigma2 : 1.0;
 }
 
-SourceCloud source_from_map(const map::ConstMapView& m, std::size_t voxel_capacity) {
-  SourceCloud src;
+void source_from_map(const map::ConstMapView& m, std::size_t voxel_capacity, SourceCloud& source) {
   std::size_t points = 0;
   for (std::size_t v = 0; v < voxel_capacity; ++v) points += static_cast<std::size_t>(m.voxel_counts[v]);
-  src.points.reserve(points);
-  src.covs.reserve(points);
-  for (std::size_t v = 0; v < voxel_capacity; ++v) {
-    const auto vox = static_cast<std::int32_t>(v);
-    for (std::int32_t j = 0; j < m.voxel_counts[v]; ++j) {
-      src.points.push_back(m.points[m.point_index(vox, j)]);
-      src.covs.push_back(m.covs[m.point_index(vox, j)]);
-    }
+  source.points.resize(points);
+  source.covs.resize(points);
+  // a voxel's points are consecutive in the pool: one copy a voxel
+  std::size_t i = 0;
+  for (std::size_t v = 0; v < voxel_capacity && i < points; ++v) {
+    const std::int32_t n = m.voxel_counts[v];
+    if (n == 0) continue;
+    const std::int64_t first = m.point_index(static_cast<std::int32_t>(v), 0);
+    std::copy_n(m.points + first, n, source.points.begin() + static_cast<std::ptrdiff_t>(i));
+    std::copy_n(m.covs + first, n, source.covs.begin() + static_cast<std::ptrdiff_t>(i));
+    i += static_cast<std::size_t>(n);
   }
-  return src;
+}
+
+SourceCloud source_from_map(const map::ConstMapView& m, std::size_t voxel_capacity) {
+  SourceCloud source;
+  source_from_map(m, voxel_capacity, source);
+  return source;
 }
 
 FactorParams factor_params(const SE3& T, const Thresholds& th, const RegistrationConfig& config) {

@@ -36,6 +36,9 @@ struct RegistrationResult {
 
 /// The stored points of a map with their covariances (the per-scan frame map gives the source).
 SourceCloud source_from_map(const map::ConstMapView& frame_map, std::size_t voxel_capacity);
+/// The same into `source`, whose buffers are kept (no allocation per scan once they are large
+/// enough).
+void source_from_map(const map::ConstMapView& frame_map, std::size_t voxel_capacity, SourceCloud& source);
 
 /// Correspondence distance (3 sigma) and kernel scale (sigma / 3), as in KISS-ICP, and the
 /// weight of point-to-point factors.
