@@ -48,8 +48,8 @@ TEST(KeyGrouping, EqualsSortingTheKeyIndexPairs) {
     }
     expect_equals_the_sort(g, keys);
   }
-  // runs of one key, as points in the order of their downsampling cells give (a key equal to
-  // the previous index's skips the table), with a key coming back after other runs
+  // runs of one key, as points in the order of their downsampling cells give, with a key
+  // coming back after other runs
   std::vector<std::uint64_t> runs;
   std::uniform_int_distribution<int> run_length(1, 12), run_key(0, 40);
   while (runs.size() < 20000) {
