@@ -306,6 +306,34 @@ TEST(Covariance, ClosedFormEigenvaluesEqualEigensSolver) {
   EXPECT_TRUE(symmetric_eigenvalues(2.0f * Eigen::Matrix3f::Identity()).isApproxToConstant(2.0f));
 }
 
+TEST(Covariance, ShapeOfRegularisedCovariancesAgreesWithADoubleSolver) {
+  // the shape test on covariances as the maps make them (spreads 0.01 to 1 m^2, a third of them
+  // line-like, eps = 1e-3, Frobenius-normalised) against the same test on a double-precision
+  // solver's eigenvalues: float rounding may flip a shape only right at the ratio
+  std::mt19937 rng(12);
+  std::normal_distribution<float> g(0.0f, 1.0f);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  const float eps = 1e-3f, ratio = 10.0f;
+  int lines = 0, disagreements = 0;
+  constexpr int kTrials = 20000;
+  for (int trial = 0; trial < kTrials; ++trial) {
+    Eigen::Matrix3f a;
+    for (int i = 0; i < 9; ++i) a.data()[i] = g(rng);
+    const Eigen::Matrix3f q = a.householderQr().householderQ();
+    const float e2 = 0.01f + u(rng), e1 = e2 * (trial % 3 == 0 ? 1e-3f * u(rng) : u(rng)), e0 = e1 * u(rng) * u(rng);
+    const Eigen::Matrix3f sample = q * Eigen::Vector3f(e0, e1, e2).asDiagonal() * q.transpose();
+    const Eigen::Matrix3f c = regularize_frobenius(0.5f * (sample + sample.transpose()), eps);
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(c.cast<double>());
+    const Eigen::Vector3d ev = es.eigenvalues();
+    const bool line = ev(1) < ratio * ev(0) && ev(2) > ratio * ev(0);
+    lines += line ? 1 : 0;
+    disagreements += (classify_shape(c, ratio) == PointShape::Line) != line ? 1 : 0;
+  }
+  EXPECT_GT(lines, kTrials / 4);  // both shapes are exercised
+  EXPECT_LT(lines, 3 * kTrials / 4);
+  EXPECT_LE(disagreements, kTrials / 1000);
+}
+
 TEST(Covariance, ShapeOfLinesAndPlanes) {
   const float eps = 1e-3f;
   Eigen::Matrix3f line = Eigen::Matrix3f::Zero(), plane = Eigen::Matrix3f::Zero();
