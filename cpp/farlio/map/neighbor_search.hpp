@@ -5,11 +5,15 @@
 // same 27 voxels. Shared by CPU and CUDA.
 #include <Eigen/Core>
 #include <cstdint>
+#include <limits>
 
 #include "farlio/core/config.hpp"
 #include "farlio/exec/hd.hpp"
 #include "farlio/exec/hd_math.hpp"
 #include "farlio/map/map_view.hpp"
+#if defined(__SSE2__) && !defined(FARLIO_ON_DEVICE)
+#include <emmintrin.h>
+#endif
 
 namespace farlio::map {
 
@@ -173,6 +177,51 @@ inline constexpr int kSlotBits = 10;
 static_assert(kMaxPointsPerVoxel < (1 << kSlotBits) && kNeighborVoxels < (1 << (32 - kSlotBits)),
               "a k-NN key's visit position holds a voxel's slot and the voxel's rank in the walk");
 
+/// Points of the first voxel a k-NN visits that the host ranks at once (rank_first_voxel).
+inline constexpr int kRankedVoxelPoints = 32;
+
+#if defined(__SSE2__) && !defined(FARLIO_ON_DEVICE)
+/// The k-NN list after the first voxel of a walk, on the host: each of its n <= 32 points is
+/// ranked by counting the points before it in (distance, slot) order, four comparisons at a
+/// time, and the k first go to their places in `best` (the others to best[kMaxNeighbors], a
+/// scratch slot). The same list as inserting them one by one, without the insertions' branches,
+/// which depend on the distances (most of the k-NN's time: docs/performance.md, stop 27).
+/// Returns how many are in the list.
+inline int rank_first_voxel(const ConstMapView& m, std::int64_t first, std::int32_t n, const Eigen::Vector3f& query,
+                            int k, float bound, std::uint64_t* best) {
+  alignas(16) float d[kRankedVoxelPoints];
+  for (std::int32_t j0 = 0; j0 < n; j0 += kDistanceBlock) block_distances2(m, first + j0, n - j0, query, d + j0);
+  const int padded = (n + 3) & ~3;
+  int valid = 0;
+  for (int j = 0; j < padded; ++j) {
+    const bool in = j < n && d[j] < bound;  // beyond the bound or padding: after every valid one
+    d[j] = in ? d[j] : std::numeric_limits<float>::infinity();
+    valid += in ? 1 : 0;
+  }
+  const int kept = valid < k ? valid : k;
+  const __m128i lanes = _mm_set_epi32(3, 2, 1, 0);
+  for (int i = 0; i < n; ++i) {
+    if (!(d[i] < std::numeric_limits<float>::infinity())) continue;
+    const __m128 di = _mm_set1_ps(d[i]);
+    const __m128i slot_i = _mm_set1_epi32(i);
+    __m128i count = _mm_setzero_si128();
+    for (int j = 0; j < padded; j += 4) {
+      const __m128 dj = _mm_load_ps(d + j);
+      const __m128i earlier = _mm_cmplt_epi32(_mm_add_epi32(_mm_set1_epi32(j), lanes), slot_i);
+      const __m128i before = _mm_or_si128(_mm_castps_si128(_mm_cmplt_ps(dj, di)),
+                                          _mm_and_si128(_mm_castps_si128(_mm_cmpeq_ps(dj, di)), earlier));
+      count = _mm_sub_epi32(count, before);  // a true lane is -1
+    }
+    alignas(16) std::int32_t c[4];
+    _mm_store_si128(reinterpret_cast<__m128i*>(c), count);
+    const int place = c[0] + c[1] + c[2] + c[3];
+    best[place < kept ? place : kMaxNeighbors] =
+        (static_cast<std::uint64_t>(exec::float_bits(d[i])) << 32) | static_cast<std::uint64_t>(i);
+  }
+  return kept;
+}
+#endif
+
 /// The k nearest points to p (k <= kMaxNeighbors) within sqrt(max_distance2), sorted by
 /// distance, over the voxels walk(bound2, visit) visits; of equal distances the one visited first
 /// is the nearer. Returns how many were found. Each candidate is one 64-bit key, the distance's
@@ -181,8 +230,8 @@ static_assert(kMaxPointsPerVoxel < (1 << kSlotBits) && kNeighborVoxels < (1 << (
 template <typename Walk>
 FARLIO_HD int knn_over(const ConstMapView& m, const Walk& walk, const Eigen::Vector3f& p, int k, float max_distance2,
                        std::int64_t* indices, float* distances2) {
-  std::uint64_t best[kMaxNeighbors];
-  std::int32_t walked[kNeighborVoxels];  // the voxels in visit order
+  std::uint64_t best[kMaxNeighbors + 1];  // + a scratch slot (rank_first_voxel)
+  std::int32_t walked[kNeighborVoxels];   // the voxels in visit order
   int voxels = 0, found = 0;
   float bound = max_distance2;
   const Eigen::Vector3f query = p;  // a copy: the list's stores cannot alias it
@@ -197,6 +246,13 @@ FARLIO_HD int knn_over(const ConstMapView& m, const Walk& walk, const Eigen::Vec
          float voxel_bound = bound;
          int voxel_found = found;
          const int kk = k;
+#if defined(__SSE2__) && !defined(FARLIO_ON_DEVICE)
+         if (rank == 0 && n <= kRankedVoxelPoints) {
+           found = rank_first_voxel(m, first, n, query, kk, voxel_bound, best);
+           if (found == kk) bound = exec::float_from_bits(static_cast<std::uint32_t>(best[kk - 1] >> 32));
+           return;
+         }
+#endif
          // distances of a block of points first, then the few that pass the bound are inserted
          for (std::int32_t j0 = 0; j0 < n; j0 += kDistanceBlock) {
            float block[kDistanceBlock];
