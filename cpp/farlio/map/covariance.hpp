@@ -72,9 +72,8 @@ FARLIO_HD inline Eigen::Vector3f symmetric_eigenvalues(const Eigen::Matrix3f& a)
   const float d0 = a(0, 0) - q, d1 = a(1, 1) - q, d2 = a(2, 2) - q;
   const float p = sqrtf((d0 * d0 + d1 * d1 + d2 * d2 + 2.0f * off2) / 6.0f);
   if (p <= 0.0f) return Eigen::Vector3f::Constant(q);  // a multiple of the identity
-  // r = det((a - q I) / p) / 2, with one division instead of nine
-  const Eigen::Matrix3f shifted = a - q * Eigen::Matrix3f::Identity();
-  const float r = exec::min_of(1.0f, exec::max_of(-1.0f, 0.5f * shifted.determinant() / (p * p * p)));
+  const Eigen::Matrix3f b = (a - q * Eigen::Matrix3f::Identity()) / p;
+  const float r = exec::min_of(1.0f, exec::max_of(-1.0f, 0.5f * b.determinant()));
   constexpr float kSixth = 1.0f / 6.0f, kThird = 1.0f / 3.0f, kSqrt3 = 1.7320508f;
   // the start a - a^2 / 3 + 0.1757 a^3 with a = sqrt((1 - r) / 6): the root's series to second
   // order, its third coefficient fitted on [0, 2]; within 1.4e-3 of the root, so two steps reach
