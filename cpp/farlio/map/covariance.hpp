@@ -111,16 +111,41 @@ FARLIO_HD inline PointShape classify_shape(const Eigen::Matrix3f& regularized_co
   return line ? PointShape::Line : PointShape::Surface;
 }
 
-/// Frobenius-norm regularisation of eq. (1): ||C^-1||_F from C's cofactors, ||adj C||_F / |det C|
-/// (C is symmetric, so 6 distinct cofactors), without forming the inverse.
+/// The 6 distinct cofactors of a symmetric 3x3 matrix C (upper triangle of adj C) and det C: the
+/// Frobenius regularisation's ||C^-1||_F and the GICP factor's inverse, without Eigen's generic
+/// inverse.
+struct SymmetricCofactors {
+  float c00, c01, c02, c11, c12, c22, det;
+
+  FARLIO_HD explicit SymmetricCofactors(const Eigen::Matrix3f& c) {
+    const float a = c(0, 0), b = c(0, 1), d = c(0, 2), e = c(1, 1), f = c(1, 2), g = c(2, 2);
+    c00 = e * g - f * f;
+    c01 = d * f - b * g;
+    c02 = b * f - d * e;
+    c11 = a * g - d * d;
+    c12 = b * d - a * f;
+    c22 = a * e - b * b;
+    det = a * c00 + b * c01 + d * c02;
+  }
+  /// ||adj C||_F
+  [[nodiscard]] FARLIO_HD float adjugate_norm() const {
+    return sqrtf(c00 * c00 + c11 * c11 + c22 * c22 + 2.0f * (c01 * c01 + c02 * c02 + c12 * c12));
+  }
+  /// C^-1 = adj C / det C
+  [[nodiscard]] FARLIO_HD Eigen::Matrix3f inverse() const {
+    const float inv_det = 1.0f / det;
+    Eigen::Matrix3f adjugate;
+    adjugate << c00, c01, c02, c01, c11, c12, c02, c12, c22;
+    return adjugate * inv_det;
+  }
+};
+
+/// Frobenius-norm regularisation of eq. (1): ||C^-1||_F = ||adj C||_F / |det C|, without forming
+/// the inverse.
 FARLIO_HD inline Eigen::Matrix3f regularize_frobenius(const Eigen::Matrix3f& sample_cov, float epsilon) {
   const Eigen::Matrix3f c = sample_cov + epsilon * Eigen::Matrix3f::Identity();
-  const float a = c(0, 0), b = c(0, 1), d = c(0, 2), e = c(1, 1), f = c(1, 2), g = c(2, 2);
-  const float c00 = e * g - f * f, c01 = d * f - b * g, c02 = b * f - d * e;
-  const float c11 = a * g - d * d, c12 = b * d - a * f, c22 = a * e - b * b;
-  const float det = a * c00 + b * c01 + d * c02;
-  const float adjugate2 = c00 * c00 + c11 * c11 + c22 * c22 + 2.0f * (c01 * c01 + c02 * c02 + c12 * c12);
-  return (sqrtf(adjugate2) / fabsf(det)) * c;
+  const SymmetricCofactors cof(c);
+  return (cof.adjugate_norm() / fabsf(cof.det)) * c;
 }
 
 }  // namespace farlio::map

@@ -10,11 +10,11 @@
 // skip_line_pairs. Plain ICP (sparsity_aware false) uses Omega = I for every pair. The Jacobian of r under a right
 // perturbation T exp(delta), delta = [rho; phi], is J = [R, -R [s]x].
 #include <Eigen/Core>
-#include <Eigen/LU>
 #include <cstdint>
 
 #include "farlio/exec/hd.hpp"
 #include "farlio/exec/hd_math.hpp"
+#include "farlio/map/covariance.hpp"
 #include "farlio/map/map_view.hpp"
 #include "farlio/map/neighbor_search.hpp"
 #include "farlio/registration/robust_kernel.hpp"
@@ -39,25 +39,14 @@ struct FactorParams {
   float point_to_point_precision = 1.0f;  ///< lambda, in the Frobenius-normalised units of Omega
 };
 
-/// C^-1 of a symmetric 3x3 matrix from its cofactors (C = C^T, so 6 of them).
-FARLIO_HD inline Eigen::Matrix3f symmetric_inverse(const Eigen::Matrix3f& c) {
-  const float a = c(0, 0), b = c(0, 1), d = c(0, 2), e = c(1, 1), f = c(1, 2), g = c(2, 2);
-  const float c00 = e * g - f * f, c01 = d * f - b * g, c02 = b * f - d * e;
-  const float c11 = a * g - d * d, c12 = b * d - a * f, c22 = a * e - b * b;
-  const float inv_det = 1.0f / (a * c00 + b * c01 + d * c02);
-  Eigen::Matrix3f inv;
-  inv << c00, c01, c02, c01, c11, c12, c02, c12, c22;
-  return inv * inv_det;
-}
-
 /// The factor of source point `s` (w = 1 if `cov_s` is valid) at its transformed position
 /// p = R s + t, matched to map point `nn` (-1: none). Returns false (and leaves `out` untouched)
 /// when there is no correspondence within the distance.
 ///
 /// With J = R [I, -[s]x] the blocks of J^T Omega J need only A = R^T Omega R, which for GICP is
 /// (R^T C_q R + C_s)^-1: H = w [A, -A S; S A, -S A S] and b = w [A r'; s x (A r')] with S = [s]x
-/// and r' = R^T r, about half the arithmetic of forming J and the 6x6 product (stop 27;
-/// tests/cpp/test_gicp.cpp checks it against that product).
+/// and r' = R^T r, about half the arithmetic of forming J and the 6x6 product; the inverse from
+/// the symmetric cofactors (stop 27; tests/cpp/test_gicp.cpp checks it against that product).
 FARLIO_HD inline bool gicp_factor_at(const map::ConstMapView& m, const Eigen::Vector4f& s, const map::Cov3& cov_s,
                                      const Eigen::Vector3f& p, std::int64_t nn, const FactorParams& fp,
                                      FactorTerms& out) {
@@ -73,7 +62,7 @@ FARLIO_HD inline bool gicp_factor_at(const map::ConstMapView& m, const Eigen::Ve
   if (fp.sparsity_aware) A *= fp.point_to_point_precision;
   if (fp.sparsity_aware && both_covariances) {
     const Eigen::Matrix3f c = fp.R.transpose() * m.covs[nn].matrix() * fp.R + cov_s.matrix();
-    const Eigen::Matrix3f inv = symmetric_inverse(c);
+    const Eigen::Matrix3f inv = map::SymmetricCofactors(c).inverse();
     if (exec::all_finite(inv)) A = inv;
   }
   const float w = fp.kernel.weight(r2);
