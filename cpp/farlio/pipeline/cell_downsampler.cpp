@@ -78,6 +78,26 @@ void CellTable::drain(std::vector<std::pair<std::uint64_t, std::int32_t>>& out) 
   used_.clear();
 }
 
+void CellDownsampler::merge_two(const std::vector<std::pair<std::uint64_t, std::int32_t>>& a,
+                                const std::vector<std::pair<std::uint64_t, std::int32_t>>& b,
+                                std::vector<std::int32_t>& out) {
+  const std::size_t na = a.size(), nb = b.size(), first = out.size();
+  out.resize(first + na + nb);
+  std::int32_t* o = out.data() + first;
+  std::size_t i = 0, j = 0;
+  while (i < na && j < nb) {
+    const std::uint64_t ka = a[i].first, kb = b[j].first;
+    const std::int32_t ia = a[i].second, ib = b[j].second;
+    const bool take_a = ka <= kb, take_b = kb <= ka;  // both: the same cell, its lower index kept
+    *o++ = take_a ? (take_b ? std::min(ia, ib) : ia) : ib;
+    i += take_a ? 1 : 0;
+    j += take_b ? 1 : 0;
+  }
+  for (; i < na; ++i) *o++ = a[i].second;
+  for (; j < nb; ++j) *o++ = b[j].second;
+  out.resize(static_cast<std::size_t>(o - out.data()));
+}
+
 const std::vector<std::int32_t>& CellDownsampler::first_of_each_cell(const std::uint64_t* keys, std::size_t n,
                                                                      exec::CpuExecutor& executor) {
   return first_of_each_cell(n, executor, [keys](std::size_t first, std::size_t count, std::uint64_t* out) {
@@ -93,8 +113,13 @@ void CellDownsampler::Block::sort_cells() {
 
 const std::vector<std::int32_t>& CellDownsampler::merge_blocks(std::size_t blocks) {
   // 2. the blocks' sorted cells merged by key; of a cell in several blocks the lowest index
-  heads_.assign(blocks, 0);
   kept_.clear();
+  if (blocks == 2) {  // two threads: one pass of two cursors (KITTI: 36 us, the loop below 59 us)
+    merge_two(blocks_[0].cells, blocks_[1].cells, kept_);
+    expected_cells_ = kept_.size();
+    return kept_;
+  }
+  heads_.assign(blocks, 0);
   for (;;) {
     std::size_t lowest = blocks;
     std::uint64_t key = 0;

@@ -1,5 +1,6 @@
 #include "farlio/pipeline/scan_backend.hpp"
 
+#include <algorithm>
 #include <limits>
 
 #include "farlio/pipeline/cpu_scan_backend.hpp"
@@ -8,6 +9,10 @@
 #endif
 
 namespace farlio::pipeline {
+namespace {
+/// Voxels the CPU frame map preallocates (a scan fills ~1-2k; the pool doubles as needed).
+constexpr std::int64_t kFrameMapInitialVoxels = 1024;
+}  // namespace
 
 VoxelMapConfig frame_map_config(const Config& c) {
   VoxelMapConfig f = c.map;
@@ -16,6 +21,9 @@ VoxelMapConfig frame_map_config(const Config& c) {
   f.max_points_per_voxel = c.density.frame_map_max_points_per_voxel;
   f.refresh_covariances = false;
   f.removal_radius_m = std::numeric_limits<double>::infinity();
+  // sized for one scan (~1-2k voxels, the pool doubles as needed), not for the submap: the
+  // per-frame clear and the voxel lookups touch a table of a few thousand slots, not 32k
+  f.initial_voxel_capacity = std::min<std::int64_t>(c.map.initial_voxel_capacity, kFrameMapInitialVoxels);
   return f;
 }
 
