@@ -133,30 +133,29 @@ InsertStats VoxelMap::insert(const std::vector<Eigen::Vector3f>& points, const E
         },
         kVoxelGrain);
   }
-  for (const auto& s : gstats) {
+  const bool refresh = config_.refresh_covariances;
+  for (std::size_t g = 0; g < groups; ++g) {
+    const GroupStats& s = gstats[g];
     stats.inserted += static_cast<std::size_t>(s.inserted);
     stats.rejected_spacing += static_cast<std::size_t>(s.spacing);
     stats.rejected_full += static_cast<std::size_t>(s.full);
+    stats.covariances_computed +=
+        static_cast<std::size_t>(covariance_points(first_new[g] + s.inserted, first_new[g], refresh).size());
   }
 
-  // 4. covariances of the new points (or of every point of a changed voxel), one task a voxel
-  std::vector<std::int32_t> cov_voxels;
-  std::vector<PointRange> cov_points;
-  for (std::size_t g = 0; g < groups; ++g) {
-    const PointRange r = covariance_points(voxel_counts_[static_cast<std::size_t>(group_voxel[g])], first_new[g],
-                                           config_.refresh_covariances);
-    if (r.size() == 0) continue;
-    cov_voxels.push_back(group_voxel[g]);
-    cov_points.push_back(r);
-    stats.covariances_computed += static_cast<std::size_t>(r.size());
-  }
+  // 4. covariances of the new points (or of every point of a changed voxel), one task a voxel;
+  // a voxel that received none is skipped inside its task (no serial list of the changed ones)
   const MapView v = view();
   const int k = config_.covariance_neighbors;
   const auto eps = static_cast<float>(config_.covariance_epsilon);
   const auto line_ratio = static_cast<float>(config_.line_eigenvalue_ratio);
   executor_->for_each(
-      cov_voxels.size(),
-      [&](std::size_t i) { update_voxel_covariances(v, cov_voxels[i], cov_points[i], k, eps, line_ratio); },
+      groups,
+      [&](std::size_t g) {
+        const std::int32_t voxel = group_voxel[g];
+        const PointRange r = covariance_points(v.voxel_counts[voxel], first_new[g], refresh);
+        update_voxel_covariances(v, voxel, r, k, eps, line_ratio);
+      },
       kVoxelGrain);
   return stats;
 }
