@@ -147,9 +147,38 @@ TEST(VoxelMap, NearestAndKnnEqualBruteForce) {
   }
 }
 
+// The k-NN's visit order of the 27 voxels around q, restated: the centre; the 7 voxels of q's
+// octant of it (across the nearer face on x, on y, on z; the xy, xz, yz edges; the corner); the
+// 19 others by their neighbor_code number.
+std::vector<int> knn_visit_order(const Eigen::Vector3f& q, const VoxelCoord& c, float voxel_size) {
+  int near[3];
+  for (int a = 0; a < 3; ++a) {
+    const float inside = q[a] - static_cast<float>(c[a]) * voxel_size;  // 0 .. voxel_size
+    near[a] = inside < voxel_size - inside ? -1 : 1;
+  }
+  const auto n_of = [](int dx, int dy, int dz) {
+    for (int n = 0; n < kNeighborVoxels; ++n) {
+      if (neighbor_voxel(VoxelCoord::Zero(), n) == VoxelCoord(dx, dy, dz)) return n;
+    }
+    return -1;
+  };
+  std::vector<int> order = {0,
+                            n_of(near[0], 0, 0),
+                            n_of(0, near[1], 0),
+                            n_of(0, 0, near[2]),
+                            n_of(near[0], near[1], 0),
+                            n_of(near[0], 0, near[2]),
+                            n_of(0, near[1], near[2]),
+                            n_of(near[0], near[1], near[2])};
+  for (int n = 1; n < kNeighborVoxels; ++n) {
+    if (std::find(order.begin(), order.end(), n) == order.end()) order.push_back(n);
+  }
+  return order;
+}
+
 // Points on a lattice have many exactly equal distances: the k nearest are the first k of the
-// candidates in the search's visit order (the 27 voxels centre first, each voxel's points in pool
-// order) stably sorted by distance, with and without a distance limit.
+// candidates in the search's visit order (knn_visit_order, each voxel's points in pool order)
+// stably sorted by distance, with and without a distance limit.
 TEST(VoxelMap, KnnBreaksDistanceTiesByVisitOrder) {
   exec::CpuExecutor ex(1);
   auto cfg = small_config();
@@ -166,8 +195,11 @@ TEST(VoxelMap, KnnBreaksDistanceTiesByVisitOrder) {
   for (const float limit_m : {100.0f, 0.3f}) {
     for (const auto& q : lattice) {
       std::vector<std::pair<float, std::int64_t>> visit;  // (d2, pool index) in visit order
-      for (int n = 0; n < kNeighborVoxels; ++n) {
-        const std::int32_t vox = table_find(v, neighbor_voxel(voxel_of(q, v.inv_voxel_size), n));
+      const VoxelCoord c = voxel_of(q, v.inv_voxel_size);
+      const std::vector<int> order = knn_visit_order(q, c, v.voxel_size);
+      ASSERT_EQ(order.size(), static_cast<std::size_t>(kNeighborVoxels));
+      for (const int n : order) {
+        const std::int32_t vox = table_find(v, neighbor_voxel(c, n));
         if (vox < 0) continue;
         for (std::int32_t j = 0; j < v.voxel_counts[vox]; ++j) {
           const std::int64_t i = v.point_index(vox, j);

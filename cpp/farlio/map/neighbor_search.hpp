@@ -90,10 +90,42 @@ struct BlockDistances {
   }
 };
 
-/// Calls visit(voxel_index) for each of the 27 voxels around p (centre first) that exists and
-/// whose box is closer than bound2() (re-read before each voxel, so it may shrink). Looks a
-/// voxel up only when its box passes the bound.
-template <typename Visit, typename Bound>
+/// Calls f(n) for the voxels n = 1 .. 26 of the block, those of p's octant of the centre voxel
+/// first: the 3 face neighbours across its nearer face on each axis, the 3 edge neighbours
+/// between them, the corner one; then the 19 others in the order of neighbor_code. A point's
+/// nearest neighbours outside its voxel lie mostly in those 7 (the others are at least half a
+/// voxel away), so the k-NN's bound tightens before the far voxels, which it then mostly skips.
+template <typename F>
+FARLIO_HD void for_each_block_neighbor_near_first(const BlockDistances& box, const F& f) {
+  constexpr int kCentreCode = 13;
+  const auto code = [](int x, int y, int z) { return x + 3 * y + 9 * z; };
+  const auto neighbor = [](int c) { return c < kCentreCode ? c + 1 : c; };  // neighbor_code's inverse
+  const int sx = box.along[0][0] < box.along[0][2] ? 0 : 2;
+  const int sy = box.along[1][0] < box.along[1][2] ? 0 : 2;
+  const int sz = box.along[2][0] < box.along[2][2] ? 0 : 2;
+  const int octant[7] = {code(sx, 1, 1),  code(1, sy, 1),  code(1, 1, sz),  code(sx, sy, 1),
+                         code(sx, 1, sz), code(1, sy, sz), code(sx, sy, sz)};
+  std::uint32_t done = 1u << kCentreCode;
+  for (const int c : octant) {
+    done |= 1u << c;
+    f(neighbor(c));
+  }
+  for (int c = 0; c < kNeighborVoxels; ++c) {
+    if (((done >> c) & 1u) == 0) f(neighbor(c));
+  }
+}
+
+/// The order in which a search visits the voxels around the centre: the nearest-neighbour
+/// search in the order of neighbor_code; the k-NN p's octant first, so that its list fills from
+/// nearer points (KITTI's covariance k-NN: 18 % fewer candidates, 32 % fewer insertions). The
+/// nearest-neighbour search's bound is mostly tight after the centre voxel: ordering cost it
+/// more than it saved (BM_NearestNeighbor 0.68 -> 0.73 ms, stop 28).
+enum class VisitOrder { Code, NearFirst };
+
+/// Calls visit(voxel_index) for each of the 27 voxels around p (centre first, then the others in
+/// `Order`) that exists and whose box is closer than bound2() (re-read before each voxel, so it
+/// may shrink). Looks a voxel up only when its box passes the bound.
+template <VisitOrder Order = VisitOrder::Code, typename Visit, typename Bound>
 FARLIO_HD void for_each_nearby_voxel(const ConstMapView& m, const Eigen::Vector3f& p, const Bound& bound2,
                                      const Visit& visit) {
   const VoxelCoord c0 = voxel_of(p, m.inv_voxel_size);
@@ -101,10 +133,15 @@ FARLIO_HD void for_each_nearby_voxel(const ConstMapView& m, const Eigen::Vector3
   const std::int32_t centre = table_find(m, c0);
   if (centre >= 0) visit(centre);
   if (bound2() <= box.nearest_face2()) return;  // no other voxel can be nearer
-  for (int n = 1; n < kNeighborVoxels; ++n) {
-    if (box.distance2(n) >= bound2()) continue;
+  const auto visit_neighbor = [&](int n) {
+    if (box.distance2(n) >= bound2()) return;
     const std::int32_t v = table_find(m, neighbor_voxel(c0, n));
     if (v >= 0) visit(v);
+  };
+  if constexpr (Order == VisitOrder::NearFirst) {
+    for_each_block_neighbor_near_first(box, visit_neighbor);
+  } else {
+    for (int n = 1; n < kNeighborVoxels; ++n) visit_neighbor(n);
   }
 }
 
@@ -124,16 +161,21 @@ FARLIO_HD inline VoxelNeighborhood voxel_neighborhood(const ConstMapView& m, con
 }
 
 /// for_each_nearby_voxel over a neighbourhood looked up before (p must lie in its centre voxel).
-template <typename Visit, typename Bound>
+template <VisitOrder Order = VisitOrder::Code, typename Visit, typename Bound>
 FARLIO_HD void for_each_nearby_voxel(const ConstMapView& m, const VoxelNeighborhood& nb, const Eigen::Vector3f& p,
                                      const Bound& bound2, const Visit& visit) {
   const BlockDistances box(p, nb.centre, m.voxel_size);
   if (nb.voxels[0] >= 0) visit(nb.voxels[0]);
   if (bound2() <= box.nearest_face2()) return;  // no other voxel can be nearer
-  for (int n = 1; n < kNeighborVoxels; ++n) {
-    if (nb.voxels[n] < 0) continue;
-    if (box.distance2(n) >= bound2()) continue;
+  const auto visit_neighbor = [&](int n) {
+    if (nb.voxels[n] < 0) return;
+    if (box.distance2(n) >= bound2()) return;
     visit(nb.voxels[n]);
+  };
+  if constexpr (Order == VisitOrder::NearFirst) {
+    for_each_block_neighbor_near_first(box, visit_neighbor);
+  } else {
+    for (int n = 1; n < kNeighborVoxels; ++n) visit_neighbor(n);
   }
 }
 
@@ -288,14 +330,18 @@ FARLIO_HD int knn_over(const ConstMapView& m, const Walk& walk, const Eigen::Vec
 /// distance. Returns how many were found (< k when the neighbourhood holds fewer).
 FARLIO_HD inline int knn_search(const ConstMapView& m, const Eigen::Vector3f& p, int k, float max_distance2,
                                 std::int64_t* indices, float* distances2) {
-  const auto walk = [&](const auto& bound, const auto& visit) { for_each_nearby_voxel(m, p, bound, visit); };
+  const auto walk = [&](const auto& bound, const auto& visit) {
+    for_each_nearby_voxel<VisitOrder::NearFirst>(m, p, bound, visit);
+  };
   return knn_over(m, walk, p, k, max_distance2, indices, distances2);
 }
 
 /// knn_search for a point of the centre voxel of `nb` (the same result, without the lookups).
 FARLIO_HD inline int knn_search(const ConstMapView& m, const VoxelNeighborhood& nb, const Eigen::Vector3f& p, int k,
                                 float max_distance2, std::int64_t* indices, float* distances2) {
-  const auto walk = [&](const auto& bound, const auto& visit) { for_each_nearby_voxel(m, nb, p, bound, visit); };
+  const auto walk = [&](const auto& bound, const auto& visit) {
+    for_each_nearby_voxel<VisitOrder::NearFirst>(m, nb, p, bound, visit);
+  };
   return knn_over(m, walk, p, k, max_distance2, indices, distances2);
 }
 
