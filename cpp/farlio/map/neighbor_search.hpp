@@ -94,9 +94,10 @@ struct BlockDistances {
 /// first: the 3 face neighbours across its nearer face on each axis, the 3 edge neighbours
 /// between them, the corner one; then the 19 others in the order of neighbor_code. A point's
 /// nearest neighbours outside its voxel lie mostly in those 7 (the others are at least half a
-/// voxel away), so the k-NN's bound tightens before the far voxels, which it then mostly skips.
-template <typename F>
-FARLIO_HD void for_each_block_neighbor_near_first(const BlockDistances& box, const F& f) {
+/// voxel away), so the k-NN's bound tightens before the far voxels, which it then mostly skips:
+/// when bound2() is within the nearest far side, none of the 19 is visited.
+template <typename Bound, typename F>
+FARLIO_HD void for_each_block_neighbor_near_first(const BlockDistances& box, const Bound& bound2, const F& f) {
   constexpr int kCentreCode = 13;
   const auto code = [](int x, int y, int z) { return x + 3 * y + 9 * z; };
   const auto neighbor = [](int c) { return c < kCentreCode ? c + 1 : c; };  // neighbor_code's inverse
@@ -110,6 +111,9 @@ FARLIO_HD void for_each_block_neighbor_near_first(const BlockDistances& box, con
     done |= 1u << c;
     f(neighbor(c));
   }
+  // each of the others lies beyond a far side of the centre voxel
+  const float far = exec::min_of(exec::min_of(box.along[0][2 - sx], box.along[1][2 - sy]), box.along[2][2 - sz]);
+  if (bound2() <= far * far) return;
   for (int c = 0; c < kNeighborVoxels; ++c) {
     if (((done >> c) & 1u) == 0) f(neighbor(c));
   }
@@ -139,7 +143,7 @@ FARLIO_HD void for_each_nearby_voxel(const ConstMapView& m, const Eigen::Vector3
     if (v >= 0) visit(v);
   };
   if constexpr (Order == VisitOrder::NearFirst) {
-    for_each_block_neighbor_near_first(box, visit_neighbor);
+    for_each_block_neighbor_near_first(box, bound2, visit_neighbor);
   } else {
     for (int n = 1; n < kNeighborVoxels; ++n) visit_neighbor(n);
   }
@@ -173,7 +177,7 @@ FARLIO_HD void for_each_nearby_voxel(const ConstMapView& m, const VoxelNeighborh
     visit(nb.voxels[n]);
   };
   if constexpr (Order == VisitOrder::NearFirst) {
-    for_each_block_neighbor_near_first(box, visit_neighbor);
+    for_each_block_neighbor_near_first(box, bound2, visit_neighbor);
   } else {
     for (int n = 1; n < kNeighborVoxels; ++n) visit_neighbor(n);
   }
