@@ -134,7 +134,7 @@ std::pair<double, double> knn_work(const map::ConstMapView& v, std::size_t voxel
     for (std::int32_t j = 0; j < v.voxel_counts[vox]; ++j) {
       const Eigen::Vector3f p = v.points[v.point_index(static_cast<std::int32_t>(vox), j)].head<3>();
       const auto counting_walk = [&](const auto& bound, const auto& visit) {
-        map::for_each_nearby_voxel<map::VisitOrder::NearFirst>(v, nb, p, bound, [&](std::int32_t w) {
+        map::for_each_nearby_voxel(v, nb, p, bound, [&](std::int32_t w) {
           ++visited;
           candidates += v.voxel_counts[w];
           visit(w);
