@@ -39,14 +39,14 @@ FARLIO_HD inline std::int32_t block_distances2(const ConstMapView& m, std::int64
 /// Voxels visited around a query: the 27 of the 3x3x3 block, its centre first.
 inline constexpr int kNeighborVoxels = 27;
 
+/// The code (x + 3 y + 9 z, offsets + 1) of the centre voxel of the block.
+inline constexpr int kCentreCode = 13;
+
 /// The block position of the n-th voxel around a centre (n = 0 is the centre, the rest in a
 /// fixed order): axis a is offset by digit a of the code in base 3, minus 1. The searches visit
 /// them in a per-query order (for_each_block_neighbor_near_first); all faces, then edges, then
 /// corners was not faster (BM_NearestNeighbor, BM_CovarianceKnn, stop 27).
-FARLIO_HD inline int neighbor_code(int n) {
-  constexpr int kCentreCode = 13;
-  return n == 0 ? kCentreCode : (n <= kCentreCode ? n - 1 : n);
-}
+FARLIO_HD inline int neighbor_code(int n) { return n == 0 ? kCentreCode : (n <= kCentreCode ? n - 1 : n); }
 
 /// The n-th voxel of the block around c0.
 FARLIO_HD inline VoxelCoord neighbor_voxel(const VoxelCoord& c0, int n) {
@@ -101,7 +101,6 @@ struct BlockDistances {
 /// than in the order of neighbor_code (stop 28).
 template <typename Bound, typename F>
 FARLIO_HD void for_each_block_neighbor_near_first(const BlockDistances& box, const Bound& bound2, const F& f) {
-  constexpr int kCentreCode = 13;
   const auto code = [](int x, int y, int z) { return x + 3 * y + 9 * z; };
   const auto neighbor = [](int c) { return c < kCentreCode ? c + 1 : c; };  // neighbor_code's inverse
   const int sx = box.along[0][0] < box.along[0][2] ? 0 : 2;

@@ -139,8 +139,8 @@ InsertStats VoxelMap::insert(const std::vector<Eigen::Vector3f>& points, const E
     stats.inserted += static_cast<std::size_t>(s.inserted);
     stats.rejected_spacing += static_cast<std::size_t>(s.spacing);
     stats.rejected_full += static_cast<std::size_t>(s.full);
-    stats.covariances_computed +=
-        static_cast<std::size_t>(covariance_points(first_new[g] + s.inserted, first_new[g], refresh).size());
+    stats.covariances_computed += static_cast<std::size_t>(
+        covariance_points(voxel_counts_[static_cast<std::size_t>(group_voxel[g])], first_new[g], refresh).size());
   }
 
   // 4. covariances of the new points (or of every point of a changed voxel), one task a voxel;

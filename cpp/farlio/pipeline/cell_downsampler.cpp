@@ -33,6 +33,26 @@ void radix_sort_by_key(std::vector<std::pair<std::uint64_t, std::int32_t>>& cell
     cells.swap(scratch);
   }
 }
+
+/// Merges two lists of cells sorted by key (each key once in each) in key order: out(key, index)
+/// per cell, a cell in both once with the lower index. Two cursors and no branch on the keys,
+/// whose order alternates between the lists at random (KITTI, 2 threads: 36 us, against 59 us for
+/// the k-way loop it replaced, stop 28).
+template <typename Out>
+void merge_cells(const std::vector<std::pair<std::uint64_t, std::int32_t>>& a,
+                 const std::vector<std::pair<std::uint64_t, std::int32_t>>& b, const Out& out) {
+  std::size_t i = 0, j = 0;
+  while (i < a.size() && j < b.size()) {
+    const std::uint64_t ka = a[i].first, kb = b[j].first;
+    const std::int32_t ia = a[i].second, ib = b[j].second;
+    const bool take_a = ka <= kb, take_b = kb <= ka;  // both: the same cell, its lower index kept
+    out(take_a ? ka : kb, take_a ? (take_b ? std::min(ia, ib) : ia) : ib);
+    i += take_a ? 1 : 0;
+    j += take_b ? 1 : 0;
+  }
+  for (; i < a.size(); ++i) out(a[i].first, a[i].second);
+  for (; j < b.size(); ++j) out(b[j].first, b[j].second);
+}
 }  // namespace
 
 void CellTable::reset(std::size_t expected_cells) {
@@ -78,26 +98,6 @@ void CellTable::drain(std::vector<std::pair<std::uint64_t, std::int32_t>>& out) 
   used_.clear();
 }
 
-void CellDownsampler::merge_two(const std::vector<std::pair<std::uint64_t, std::int32_t>>& a,
-                                const std::vector<std::pair<std::uint64_t, std::int32_t>>& b,
-                                std::vector<std::int32_t>& out) {
-  const std::size_t na = a.size(), nb = b.size(), first = out.size();
-  out.resize(first + na + nb);
-  std::int32_t* o = out.data() + first;
-  std::size_t i = 0, j = 0;
-  while (i < na && j < nb) {
-    const std::uint64_t ka = a[i].first, kb = b[j].first;
-    const std::int32_t ia = a[i].second, ib = b[j].second;
-    const bool take_a = ka <= kb, take_b = kb <= ka;  // both: the same cell, its lower index kept
-    *o++ = take_a ? (take_b ? std::min(ia, ib) : ia) : ib;
-    i += take_a ? 1 : 0;
-    j += take_b ? 1 : 0;
-  }
-  for (; i < na; ++i) *o++ = a[i].second;
-  for (; j < nb; ++j) *o++ = b[j].second;
-  out.resize(static_cast<std::size_t>(o - out.data()));
-}
-
 const std::vector<std::int32_t>& CellDownsampler::first_of_each_cell(const std::uint64_t* keys, std::size_t n,
                                                                      exec::CpuExecutor& executor) {
   return first_of_each_cell(n, executor, [keys](std::size_t first, std::size_t count, std::uint64_t* out) {
@@ -112,34 +112,22 @@ void CellDownsampler::Block::sort_cells() {
 }
 
 const std::vector<std::int32_t>& CellDownsampler::merge_blocks(std::size_t blocks) {
-  // 2. the blocks' sorted cells merged by key; of a cell in several blocks the lowest index
+  // 2. the blocks' sorted cells merged by key, two lists at a time (a cell in several blocks
+  // keeps its lowest index); the last merge writes the indices
   kept_.clear();
-  if (blocks == 2) {  // two threads: one pass of two cursors (KITTI: 36 us, the loop below 59 us)
-    merge_two(blocks_[0].cells, blocks_[1].cells, kept_);
-    expected_cells_ = kept_.size();
-    return kept_;
+  const std::vector<std::pair<std::uint64_t, std::int32_t>>* merged = &blocks_[0].cells;
+  for (std::size_t b = 1; b + 1 < blocks; ++b) {
+    auto& next = merged_[b % 2];  // not the list `merged` points to (merged_[(b - 1) % 2] or a block's)
+    next.clear();
+    merge_cells(*merged, blocks_[b].cells,
+                [&](std::uint64_t key, std::int32_t index) { next.emplace_back(key, index); });
+    merged = &next;
   }
-  heads_.assign(blocks, 0);
-  for (;;) {
-    std::size_t lowest = blocks;
-    std::uint64_t key = 0;
-    for (std::size_t b = 0; b < blocks; ++b) {
-      const auto& cells = blocks_[b].cells;
-      if (heads_[b] < cells.size() && (lowest == blocks || cells[heads_[b]].first < key)) {
-        lowest = b;
-        key = cells[heads_[b]].first;
-      }
-    }
-    if (lowest == blocks) break;
-    std::int32_t first = blocks_[lowest].cells[heads_[lowest]].second;
-    for (std::size_t b = lowest; b < blocks; ++b) {
-      const auto& cells = blocks_[b].cells;
-      if (heads_[b] < cells.size() && cells[heads_[b]].first == key) {
-        first = std::min(first, cells[heads_[b]].second);
-        ++heads_[b];
-      }
-    }
-    kept_.push_back(first);
+  if (blocks == 1) {
+    for (const auto& cell : *merged) kept_.push_back(cell.second);
+  } else {
+    kept_.reserve(merged->size() + blocks_[blocks - 1].cells.size());
+    merge_cells(*merged, blocks_[blocks - 1].cells, [&](std::uint64_t, std::int32_t index) { kept_.push_back(index); });
   }
   expected_cells_ = kept_.size();
   return kept_;

@@ -110,12 +110,9 @@ class CellDownsampler {
   /// The blocks' cells merged in key order, the lowest index of a cell found in several blocks
   /// kept: their indices.
   const std::vector<std::int32_t>& merge_blocks(std::size_t blocks);
-  /// The merge of two blocks' sorted cells (the two-thread case), appended to `out`.
-  static void merge_two(const std::vector<std::pair<std::uint64_t, std::int32_t>>& a,
-                        const std::vector<std::pair<std::uint64_t, std::int32_t>>& b, std::vector<std::int32_t>& out);
 
-  std::vector<Block> blocks_;       // one per block of the scan (a block per thread)
-  std::vector<std::size_t> heads_;  // merge position in each block's sorted cells
+  std::vector<Block> blocks_;  // one per block of the scan (a block per thread)
+  std::array<std::vector<std::pair<std::uint64_t, std::int32_t>>, 2> merged_;  // the merges before the last
   std::vector<std::int32_t> kept_;
   std::size_t expected_cells_ = 0;  // cells of the previous call: sizes the tables
 };
