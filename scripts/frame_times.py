@@ -4,7 +4,10 @@
 yardsticks): the median and p99 of the whole frame and, per largest frame, its stages
 (docs/performance.md, stop 27: the first frame builds the submap and is the largest).
 
-    python scripts/frame_times.py --profile urban --scans 100 --threads 2 [--data DIR] [--top 8]
+    python scripts/frame_times.py --profile urban --scans 100 --threads 2 [--data DIR] [--top 8] [--repeat N]
+
+With --repeat N the scans run N times, each time through a new pipeline (the frames of all runs
+counted): enough frames of a short recording for `perf record` to sample (docs/performance.md).
 """
 
 from __future__ import annotations
@@ -27,6 +30,7 @@ def main() -> None:
     p.add_argument("--scans", type=int, default=100, help="generated scans")
     p.add_argument("--threads", type=int, default=2, help="threads of the pipeline")
     p.add_argument("--top", type=int, default=8, help="largest frames listed")
+    p.add_argument("--repeat", type=int, default=1, help="runs over the scans, each with a new pipeline")
     args = p.parse_args()
     if args.data:
         ds = open_dataset(args.data)
@@ -36,11 +40,12 @@ def main() -> None:
     config = _core.Config()
     config.set("num_threads", str(args.threads))
     config.set("device", "cpu")
-    pipe = _core.ScanPipeline(config)
     rows = []
-    for i, scan in enumerate(scans):
-        t = pipe.process(scan).timings
-        rows.append((t.total_s * MS_PER_S, i, [getattr(t, a) * MS_PER_S for a in STAGES.values()]))
+    for _ in range(max(1, args.repeat)):
+        pipe = _core.ScanPipeline(config)
+        for i, scan in enumerate(scans):
+            t = pipe.process(scan).timings
+            rows.append((t.total_s * MS_PER_S, i, [getattr(t, a) * MS_PER_S for a in STAGES.values()]))
     total = np.array([r[0] for r in rows])
     median, p99 = float(np.median(total)), float(np.percentile(total, P99))
     print(
