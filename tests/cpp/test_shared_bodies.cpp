@@ -176,6 +176,38 @@ TEST(SharedBodies, FactorSumsReduceToTheSameSystemAsPerPointSums) {
   EXPECT_NEAR(sys.error, ref.error, 1e-9 * (ref.error + 1.0));
 }
 
+TEST(SharedBodies, FactorsAddedInPlaceEqualTheReduceOfPerPointSums) {
+  // the CPU adds each factor to its task's sums in place (CpuExecutor::accumulate, add_factor);
+  // CUDA reduces per-point FactorSums: on the same partition, the same doubles bit for bit
+  for (const int threads : {1, 2, 3}) {
+    exec::CpuExecutor ex(threads);
+    map::VoxelMap target(VoxelMapConfig{}, ex);
+    const auto pts = test::sample_scene(20000, 11);
+    target.insert(pts, Eigen::Vector3f::Zero(), map::PointLimit::constant(40));
+    registration::SourceCloud src;
+    for (std::size_t i = 0; i < pts.size(); i += 7) {  // some beyond the gate: no correspondence
+      src.points.emplace_back(pts[i].x() + (i % 3 == 0 ? 5.0f : 0.05f), pts[i].y(), pts[i].z(), 0.0f);
+      src.covs.emplace_back();
+    }
+    const auto th = registration::Thresholds::from_sigma(0.5);
+    const SE3 T = SE3::exp((registration::Vec6d() << 0.02, -0.01, 0.0, 0.0, 0.0, 0.01).finished());
+    const auto sys = registration::build_linear_system(src, target.view(), T, th, RegistrationConfig{}, ex);
+    const auto fp = registration::factor_params(T, th, RegistrationConfig{});
+    const map::ConstMapView v = target.view();
+    const auto sums = ex.reduce(
+        src.size(), registration::FactorSums::zero(),
+        [&](std::size_t i) { return registration::factor_sums(v, src.points[i], src.covs[i], fp); },
+        registration::AddFactorSums{});
+    const auto ref = registration::to_linear_system(sums);
+    EXPECT_GT(sys.inliers, 0);
+    EXPECT_LT(sys.inliers, static_cast<long>(src.size()));
+    EXPECT_EQ(sys.inliers, ref.inliers) << threads << " threads";
+    EXPECT_TRUE(sys.H == ref.H) << threads << " threads";
+    EXPECT_TRUE(sys.b == ref.b) << threads << " threads";
+    EXPECT_EQ(sys.error, ref.error) << threads << " threads";
+  }
+}
+
 TEST(SharedBodies, PerVoxelCovariancesEqualThePerPointBodyOfCuda) {
   // the CPU computes a voxel's covariances with its 27 neighbours looked up once, CUDA one
   // point a thread with its own lookups: bit-identical covariances and shapes

@@ -48,6 +48,25 @@ class CpuExecutor {
     return result;
   }
 
+  /// reduce with each index's term added to its task's running sum in place: add(acc, i) does
+  /// acc = acc + term(i). The same sums in the same order as reduce(n, identity, term, combine)
+  /// with combine(a, b) = a + b, without a term object per index.
+  template <typename T, typename Add, typename Combine>
+  T accumulate(std::size_t n, const T& identity, const Add& add, const Combine& combine) {
+    if (n == 0) return identity;
+    T result = identity;
+    arena_.execute([&] {
+      result = tbb::parallel_deterministic_reduce(
+          tbb::blocked_range<std::size_t>(0, n, kGrain), identity,
+          [&](const tbb::blocked_range<std::size_t>& r, T acc) {
+            for (std::size_t i = r.begin(); i < r.end(); ++i) add(acc, i);
+            return acc;
+          },
+          combine);
+    });
+    return result;
+  }
+
   /// Runs f() inside this executor's arena (for code that uses TBB algorithms directly).
   template <typename F>
   auto run(F&& f) {

@@ -36,14 +36,23 @@ struct AddFactorSums {
   FARLIO_HD FactorSums operator()(FactorSums a, const FactorSums& b) const { return a += b; }
 };
 
-/// A factor's terms as sums (zero when `found` is false: no correspondence).
+/// acc + the factor's terms, added in place (nothing without a correspondence: a term of zeros
+/// would leave the sums as they are). The CPU registration adds each point's factor to its task's
+/// sums with it (CpuExecutor::accumulate); building a FactorSums per point and adding it was 14 %
+/// of a Gauss-Newton iteration (BM_GicpIteration/1 1.00 -> 0.87 ms, stop 29).
+FARLIO_HD inline void add_factor(FactorSums& acc, bool found, const FactorTerms& f) {
+  if (!found) return;
+  for (int k = 0; k < kHEntries; ++k) acc.v[k] += static_cast<double>(f.H[k]);
+  for (int k = 0; k < kBEntries; ++k) acc.v[kHEntries + k] += static_cast<double>(f.b[k]);
+  acc.v[FactorSums::kCost] += static_cast<double>(f.cost);
+  acc.v[FactorSums::kInliers] += 1.0;
+}
+
+/// A factor's terms as sums (zero when `found` is false: no correspondence): one term of a
+/// reduction over points (CUDA).
 FARLIO_HD inline FactorSums factor_sums_of(bool found, const FactorTerms& f) {
   FactorSums a = FactorSums::zero();
-  if (!found) return a;
-  for (int k = 0; k < kHEntries; ++k) a.v[k] = f.H[k];
-  for (int k = 0; k < kBEntries; ++k) a.v[kHEntries + k] = f.b[k];
-  a.v[FactorSums::kCost] = f.cost;
-  a.v[FactorSums::kInliers] = 1.0;
+  add_factor(a, found, f);
   return a;
 }
 
@@ -52,15 +61,6 @@ FARLIO_HD inline FactorSums factor_sums(const map::ConstMapView& target, const E
                                         const map::Cov3& cov, const FactorParams& fp) {
   FactorTerms f;
   const bool found = gicp_factor(target, point, cov, fp, f);
-  return factor_sums_of(found, f);
-}
-
-/// factor_sums with the correspondence `c` kept across iterations (gicp_factor_reusing).
-FARLIO_HD inline FactorSums factor_sums_reusing(const map::ConstMapView& target, const Eigen::Vector4f& point,
-                                                const map::Cov3& cov, const FactorParams& fp, float reuse_distance2,
-                                                Correspondence& c) {
-  FactorTerms f;
-  const bool found = gicp_factor_reusing(target, point, cov, fp, reuse_distance2, c, f);
   return factor_sums_of(found, f);
 }
 

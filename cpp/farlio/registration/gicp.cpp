@@ -56,9 +56,13 @@ FactorParams factor_params(const SE3& T, const Thresholds& th, const Registratio
 LinearSystem build_linear_system(const SourceCloud& source, const map::ConstMapView& target, const SE3& T,
                                  const Thresholds& th, const RegistrationConfig& config, exec::CpuExecutor& executor) {
   const FactorParams fp = factor_params(T, th, config);
-  const FactorSums sum = executor.reduce(
+  const FactorSums sum = executor.accumulate(
       source.size(), FactorSums::zero(),
-      [&](std::size_t i) { return factor_sums(target, source.points[i], source.covs[i], fp); }, AddFactorSums{});
+      [&](FactorSums& acc, std::size_t i) {
+        FactorTerms f;
+        add_factor(acc, gicp_factor(target, source.points[i], source.covs[i], fp, f), f);
+      },
+      AddFactorSums{});
   return to_linear_system(sum);
 }
 
@@ -72,11 +76,12 @@ RegistrationResult register_scan(const SourceCloud& source, const map::ConstMapV
   const auto reuse2 = static_cast<float>(config.correspondence_reuse_m * config.correspondence_reuse_m);
   const auto build = [&](const SE3& T, std::size_t stride) {
     const FactorParams fp = factor_params(T, th, config);
-    return to_linear_system(executor.reduce(
+    return to_linear_system(executor.accumulate(
         strided_count(source.size(), stride), FactorSums::zero(),
-        [&](std::size_t j) {
+        [&](FactorSums& acc, std::size_t j) {
           const std::size_t i = j * stride;
-          return factor_sums_reusing(target, source.points[i], source.covs[i], fp, reuse2, matches[i]);
+          FactorTerms f;
+          add_factor(acc, gicp_factor_reusing(target, source.points[i], source.covs[i], fp, reuse2, matches[i], f), f);
         },
         AddFactorSums{}));
   };
