@@ -3,10 +3,14 @@
 // arena. The thread count belongs to the instance (no process-wide setting), so two pipelines
 // in one process do not interfere.
 #include <tbb/blocked_range.h>
+#include <tbb/info.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cstddef>
 
 namespace farlio::exec {
@@ -67,6 +71,29 @@ class CpuExecutor {
     return result;
   }
 
+  /// Brings up the threads of the arena before the first parallel loop: TBB starts a worker
+  /// when the first loop asks for it, and that loop (a pipeline's first frame) waits for it.
+  /// One task per thread waits until every thread has taken one, or until `timeout` (fewer
+  /// threads than asked may be available: more than the machine's cores, other arenas).
+  /// Returns how many threads took part.
+  int warm_up(std::chrono::microseconds timeout = kWarmUpTimeout) {
+    const int threads = std::min(num_threads(), tbb::info::default_concurrency());
+    if (threads <= 1) return 1;
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    std::atomic<int> arrived{0};
+    arena_.execute([&] {
+      tbb::parallel_for(
+          0, threads, 1,
+          [&](int) {
+            arrived.fetch_add(1, std::memory_order_relaxed);
+            while (arrived.load(std::memory_order_relaxed) < threads && std::chrono::steady_clock::now() < deadline) {
+            }
+          },
+          tbb::simple_partitioner());
+    });
+    return std::min(arrived.load(), threads);
+  }
+
   /// Runs f() inside this executor's arena (for code that uses TBB algorithms directly).
   template <typename F>
   auto run(F&& f) {
@@ -75,6 +102,8 @@ class CpuExecutor {
 
  private:
   static constexpr std::size_t kGrain = 256;  // indices per task: small enough to balance
+  /// How long warm_up waits for the threads (starting one takes well under a millisecond).
+  static constexpr std::chrono::microseconds kWarmUpTimeout{10000};
   tbb::task_arena arena_;
 };
 
