@@ -23,8 +23,8 @@ TEST(CpuExecutor, AccumulateAddsInTheOrderOfReduce) {
     exec::CpuExecutor ex(threads);
     for (const std::size_t n : {std::size_t{1}, std::size_t{255}, std::size_t{1000}, std::size_t{100000}}) {
       const double reduced = ex.reduce(n, 0.0, term, [](double a, double b) { return a + b; });
-      const double accumulated =
-          ex.accumulate(n, 0.0, [](double& acc, std::size_t i) { acc += term(i); }, [](double a, double b) { return a + b; });
+      const double accumulated = ex.accumulate(
+          n, 0.0, [](double& acc, std::size_t i) { acc += term(i); }, [](double a, double b) { return a + b; });
       EXPECT_EQ(accumulated, reduced) << threads << " threads, n = " << n;  // bit for bit
     }
   }
@@ -32,7 +32,8 @@ TEST(CpuExecutor, AccumulateAddsInTheOrderOfReduce) {
 
 TEST(CpuExecutor, AccumulateOfNothingIsTheIdentity) {
   exec::CpuExecutor ex(2);
-  EXPECT_EQ(ex.accumulate(0, 7.0, [](double& acc, std::size_t) { acc += 1.0; }, [](double a, double b) { return a + b; }),
+  EXPECT_EQ(ex.accumulate(
+                0, 7.0, [](double& acc, std::size_t) { acc += 1.0; }, [](double a, double b) { return a + b; }),
             7.0);
 }
 

@@ -111,3 +111,36 @@ def test_help_documents_every_option():
     bench = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction)).choices["bench"]
     for action in bench._actions:
         assert action.help and action.help != argparse.SUPPRESS, action.option_strings
+
+
+def test_rounds_pool_the_frames_of_passes_that_give_the_same_poses(tmp_path):
+    """--rounds N: N passes, each with a new pipeline; the poses of every pass are the same (the
+    accuracy and work of one pass), the frame times of all are pooled."""
+    one, two = tmp_path / "one", tmp_path / "two"
+    text = io.StringIO()
+    with redirect_stdout(text):
+        assert main(BENCH + ["--threads", "2", "--out", str(one)]) == 0
+        assert main(BENCH + ["--threads", "2", "--rounds", "2", "--out", str(two)]) == 0
+    r1 = json.loads((one / "bench.json").read_text())[PROFILE]
+    r2 = json.loads((two / "bench.json").read_text())[PROFILE]
+    assert (r1["rounds"], r2["rounds"]) == (1, 2)
+    assert r2["frames"] == r1["frames"] == SCANS
+    assert r2["farlio"]["accuracy"] == r1["farlio"]["accuracy"]
+    assert r1["farlio"]["accuracy"]["ape_m"] > 0
+    assert r2["farlio"]["work"] == r1["farlio"]["work"]
+    assert "2 rounds in turns with KISS-ICP" in text.getvalue()
+
+
+def test_rounds_give_each_pass_its_ratio_next_to_kiss_icp():
+    pytest.importorskip("kiss_icp")
+    from farlio.benchmark import compare
+
+    scans, gt, _ = generated_scans(PROFILE, 3)
+    r = compare(scans, gt, threads=1, device="cpu", rounds=2)
+    assert r["rounds"] == 2
+    per_round = r["speedup_median_per_round"]
+    assert len(per_round) == 2 and all(x > 0 for x in per_round), per_round
+    assert r["kiss_icp"]["accuracy"]["ape_m"] >= 0
+    assert r["speedup_median"] == pytest.approx(
+        r["kiss_icp"]["latency_ms"]["median"] / r["farlio"]["latency_ms"]["median"]
+    )

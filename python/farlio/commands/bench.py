@@ -46,6 +46,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default="auto",
         help="farlio's backend: auto (the GPU when present, else the CPU with a message), cpu, cuda",
     )
+    parser.add_argument(
+        "--rounds",
+        type=positive_int,
+        default=1,
+        help="passes over each data set, farlio and KISS-ICP in turns, each pass with a new pipeline; the "
+        "frames of all passes are pooled (a machine whose load comes and goes then weighs on both alike) "
+        "and each pass's ratio of the medians is printed",
+    )
     parser.add_argument("--no-kiss", action="store_true", help="farlio only (KISS-ICP: pip install kiss-icp)")
     parser.add_argument(
         "--out",
@@ -76,7 +84,9 @@ def run(args: argparse.Namespace) -> int:
     for name, scans, gt in _data_sets(args):
         for threads in thread_counts:
             key = result_key(name, threads, len(thread_counts) > 1)
-            results[key] = compare(scans, gt, threads=threads, with_kiss=not args.no_kiss, device=args.device)
+            results[key] = compare(
+                scans, gt, threads=threads, with_kiss=not args.no_kiss, device=args.device, rounds=args.rounds
+            )
             print(format_table(name, results[key]), flush=True)
     if args.out:
         args.out.mkdir(parents=True, exist_ok=True)
