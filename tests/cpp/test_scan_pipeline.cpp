@@ -1,6 +1,7 @@
 // The scan pipeline (LiDAR-only) on scans of a synthetic scene seen from a known trajectory.
 #include <gtest/gtest.h>
 
+#include "farlio/pipeline/cpu_scan_backend.hpp"
 #include "farlio/pipeline/scan_pipeline.hpp"
 #include "scene_fixture.hpp"
 
@@ -50,6 +51,21 @@ TEST(ScanPipeline, TracksAKnownTrajectory) {
   EXPECT_NEAR(v_world.x(), 1.5, 0.3);
   EXPECT_LE(p.backend().map_points(),
             p.backend().map_voxels() * static_cast<std::size_t>(cfg.map.max_points_per_voxel));
+}
+
+TEST(ScanPipeline, SourceWithoutCovariancesHasTheSamePointsAndDensity) {
+  // the first scan (no submap yet) builds its source without covariances: nothing reads them,
+  // and the points and the density (the map's limit) are those of the full source
+  Config cfg;
+  cfg.num_threads = 2;
+  pipeline::CpuScanBackend backend(cfg);
+  const Scan scan = make_scan(0, 0.1);
+  ASSERT_GT(backend.preprocess(scan, deskew::ScanMotion{}, false), 1000u);
+  const pipeline::SourceSummary without = backend.build_source(cfg.density.close_range_m, false);
+  const pipeline::SourceSummary with = backend.build_source(cfg.density.close_range_m, true);
+  EXPECT_GT(with.points, 500u);
+  EXPECT_EQ(without.points, with.points);
+  EXPECT_EQ(without.mean_points_per_voxel, with.mean_points_per_voxel);
 }
 
 TEST(ScanPipeline, EmptyAndDegenerateScansDoNotCrash) {

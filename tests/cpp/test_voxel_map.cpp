@@ -94,6 +94,31 @@ TEST(VoxelMap, ContentsDoNotDependOnThreadCount) {
   for (std::size_t i = 0; i < pa.size(); ++i) ASSERT_EQ(pa[i], pb[i]);
 }
 
+TEST(VoxelMap, InsertionWithoutCovariancesStoresTheSamePoints) {
+  // CovarianceUpdate::Skip (the first scan's frame map): the same points in the same voxels and
+  // order, none with a covariance; the default computes them
+  const auto pts = random_cloud(20000, 6.0f, 4);
+  exec::CpuExecutor ex(2);
+  VoxelMap with(small_config(), ex), without(small_config(), ex);
+  const InsertStats sw = with.insert(pts, Eigen::Vector3f::Zero(), PointLimit::constant(20));
+  const InsertStats so = without.insert(pts, Eigen::Vector3f::Zero(), PointLimit::constant(20), CovarianceUpdate::Skip);
+  EXPECT_EQ(so.inserted, sw.inserted);
+  EXPECT_EQ(so.rejected_spacing, sw.rejected_spacing);
+  EXPECT_EQ(so.new_voxels, sw.new_voxels);
+  EXPECT_EQ(sw.covariances_computed, sw.inserted);
+  EXPECT_EQ(so.covariances_computed, 0u);
+  const MapSnapshot a = with.snapshot(), b = without.snapshot();
+  ASSERT_EQ(a.voxel_keys, b.voxel_keys);
+  ASSERT_EQ(a.voxel_counts, b.voxel_counts);
+  std::size_t with_covariance = 0;
+  for (std::size_t i = 0; i < a.points.size(); ++i) {
+    ASSERT_EQ(a.points[i].head<3>(), b.points[i].head<3>()) << i;
+    EXPECT_FALSE(has_covariance(b.points[i])) << i;
+    with_covariance += has_covariance(a.points[i]) ? 1 : 0;
+  }
+  EXPECT_GT(with_covariance, sw.inserted / 2);
+}
+
 TEST(VoxelMap, AdaptiveLimitDecaysWithRange) {
   PointLimit lim{20, 20.0f, 0.03f, 10};
   EXPECT_EQ(lim.at(5.0f), 20);

@@ -107,11 +107,12 @@ class CudaScanBackend final : public pipeline::ScanBackend {
     return kept;
   }
 
-  pipeline::SourceSummary build_source(double density_range_m) override {
+  pipeline::SourceSummary build_source(double density_range_m, bool covariances) override {
     timer_.start(StageTimer::kSource);
     frame_map_.clear();
     frame_map_.insert(frame_.data(), frame_size_, Eigen::Vector3f::Zero(),
-                      map::PointLimit::constant(config_.density.frame_map_max_points_per_voxel), points_within_m());
+                      map::PointLimit::constant(config_.density.frame_map_max_points_per_voxel), points_within_m(),
+                      covariances ? map::CovarianceUpdate::Compute : map::CovarianceUpdate::Skip);
     source_size_ =
         frame_map_.gather(source_points_.data(), source_covs_.data(), source_points_.capacity(), kScanParameter);
     pipeline::SourceSummary out{source_size_,

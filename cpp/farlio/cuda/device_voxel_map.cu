@@ -122,7 +122,8 @@ void DeviceVoxelMap::rehash() {
 }
 
 map::InsertStats DeviceVoxelMap::insert(const Eigen::Vector3f* points, std::size_t n, const Eigen::Vector3f& origin,
-                                        const map::PointLimit& limit, double within_m) {
+                                        const map::PointLimit& limit, double within_m,
+                                        map::CovarianceUpdate covariances) {
   map::InsertStats stats;
   stats.candidates = n;
   if (n == 0) return stats;
@@ -193,6 +194,7 @@ map::InsertStats DeviceVoxelMap::insert(const Eigen::Vector3f* points, std::size
         map::insert_voxel_group(v, group_voxel[g], candidate, group_start[g], group_start[g + 1], ip, &first_new[g]);
   });
   const bool refresh = config_.refresh_covariances;
+  const bool compute = covariances == map::CovarianceUpdate::Compute;
   const InsertTotals totals = ex.reduce(
       groups, InsertTotals{},
       [=] __device__(std::size_t g) {
@@ -200,7 +202,8 @@ map::InsertStats DeviceVoxelMap::insert(const Eigen::Vector3f* points, std::size
         t.inserted = gstats[g].inserted;
         t.spacing = gstats[g].spacing;
         t.full = gstats[g].full;
-        t.covariances = map::covariance_points(v.voxel_counts[group_voxel[g]], first_new[g], refresh).size();
+        t.covariances =
+            compute ? map::covariance_points(v.voxel_counts[group_voxel[g]], first_new[g], refresh).size() : 0;
         if (g == 0) t.table_full = *table_full;
         return t;
       },

@@ -47,7 +47,8 @@ class DeviceVoxelMap {
   /// the points are expected (a scan's crop range): their voxels are then sorted on short keys
   /// (map::KeyWindow); a point farther away costs a second sort, never a wrong result.
   map::InsertStats insert(const Eigen::Vector3f* points, std::size_t n, const Eigen::Vector3f& origin,
-                          const map::PointLimit& limit, double within_m = std::numeric_limits<double>::infinity());
+                          const map::PointLimit& limit, double within_m = std::numeric_limits<double>::infinity(),
+                          map::CovarianceUpdate covariances = map::CovarianceUpdate::Compute);
   /// Removes voxels whose centre is farther than removal_radius_m from origin.
   std::size_t remove_far(const Eigen::Vector3f& origin);
   /// Mean points per voxel over voxels whose centre lies within range_m of origin (0: none).

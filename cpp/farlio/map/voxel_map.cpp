@@ -8,7 +8,6 @@
 
 #include "farlio/core/config_fields.hpp"
 #include "farlio/core/error.hpp"
-#include "farlio/map/voxel_update.hpp"
 
 namespace farlio::map {
 namespace {
@@ -71,7 +70,7 @@ void VoxelMap::rehash(std::size_t slots) {
 void VoxelMap::set_table_capacity_for_testing(std::size_t slots) { rehash(std::bit_ceil(slots)); }
 
 InsertStats VoxelMap::insert(const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& origin,
-                             const PointLimit& limit) {
+                             const PointLimit& limit, CovarianceUpdate covariances) {
   InsertStats stats;
   stats.candidates = points.size();
   const float inv_voxel = static_cast<float>(1.0 / config_.voxel_size_m);
@@ -134,14 +133,18 @@ InsertStats VoxelMap::insert(const std::vector<Eigen::Vector3f>& points, const E
         kVoxelGrain);
   }
   const bool refresh = config_.refresh_covariances;
+  const bool compute = covariances == CovarianceUpdate::Compute;
   for (std::size_t g = 0; g < groups; ++g) {
     const GroupStats& s = gstats[g];
     stats.inserted += static_cast<std::size_t>(s.inserted);
     stats.rejected_spacing += static_cast<std::size_t>(s.spacing);
     stats.rejected_full += static_cast<std::size_t>(s.full);
-    stats.covariances_computed += static_cast<std::size_t>(
-        covariance_points(voxel_counts_[static_cast<std::size_t>(group_voxel[g])], first_new[g], refresh).size());
+    if (compute) {
+      stats.covariances_computed += static_cast<std::size_t>(
+          covariance_points(voxel_counts_[static_cast<std::size_t>(group_voxel[g])], first_new[g], refresh).size());
+    }
   }
+  if (!compute) return stats;
 
   // 4. covariances of the new points (or of every point of a changed voxel), one task a voxel;
   // a voxel that received none is skipped inside its task (no serial list of the changed ones)

@@ -20,6 +20,7 @@
 #include "farlio/map/map_view.hpp"
 #include "farlio/map/point_limit.hpp"
 #include "farlio/map/voxel_pool.hpp"
+#include "farlio/map/voxel_update.hpp"
 
 namespace farlio::map {
 
@@ -43,9 +44,9 @@ class VoxelMap {
 
   /// Inserts world-frame points; the limit of each point depends on its distance to `origin`
   /// (the sensor position). Then computes covariances of the new points (and of all points of
-  /// the voxels that changed, when config.refresh_covariances).
-  InsertStats insert(const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& origin,
-                     const PointLimit& limit);
+  /// the voxels that changed, when config.refresh_covariances), unless `covariances` is Skip.
+  InsertStats insert(const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& origin, const PointLimit& limit,
+                     CovarianceUpdate covariances = CovarianceUpdate::Compute);
   /// Removes voxels whose centre is farther than config.removal_radius_m from `origin`.
   std::size_t remove_far(const Eigen::Vector3f& origin);
   /// Removes everything (keeps the allocation).

@@ -35,6 +35,11 @@ FARLIO_HD inline bool add_voxel(const MapView& m, std::uint64_t key, std::int32_
   return table_insert(m, key, spatial_hash(unpack_key(key)), voxel) >= 0;
 }
 
+/// Whether an insertion computes the covariances of the points it adds: Skip leaves them without
+/// one (PointShape::NoCovariance), for a map whose covariances nothing will read (the frame map
+/// of a scan with no submap to register against: the first).
+enum class CovarianceUpdate { Compute, Skip };
+
 /// What happened to one voxel's candidates.
 struct GroupStats {
   std::int32_t inserted = 0, spacing = 0, full = 0;

@@ -39,10 +39,11 @@ std::size_t CpuScanBackend::preprocess(const Scan& scan, const deskew::ScanMotio
   return frame_.size();
 }
 
-SourceSummary CpuScanBackend::build_source(double density_range_m) {
+SourceSummary CpuScanBackend::build_source(double density_range_m, bool covariances) {
   frame_map_.clear();
   frame_map_.insert(frame_, Eigen::Vector3f::Zero(),
-                    map::PointLimit::constant(config_.density.frame_map_max_points_per_voxel));
+                    map::PointLimit::constant(config_.density.frame_map_max_points_per_voxel),
+                    covariances ? map::CovarianceUpdate::Compute : map::CovarianceUpdate::Skip);
   registration::source_from_map(frame_map_.view(), frame_map_.voxel_capacity(), source_);
   return {source_.size(), frame_map_.mean_points_per_voxel(Eigen::Vector3f::Zero(), density_range_m)};
 }

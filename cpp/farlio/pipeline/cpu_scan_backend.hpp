@@ -18,7 +18,7 @@ class CpuScanBackend final : public ScanBackend {
   [[nodiscard]] Device device() const override { return Device::Cpu; }
   void reset(const Config& config) override;
   std::size_t preprocess(const Scan& scan, const deskew::ScanMotion& motion, bool undistort) override;
-  SourceSummary build_source(double density_range_m) override;
+  SourceSummary build_source(double density_range_m, bool covariances) override;
   registration::RegistrationResult register_source(const SE3& initial_guess, const registration::Thresholds& th,
                                                    const RegistrationConfig& config, double time_budget_s) override;
   map::InsertStats update_map(const SE3& pose, const map::PointLimit& limit, std::size_t* removed_voxels) override;

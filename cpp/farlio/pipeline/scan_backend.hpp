@@ -38,8 +38,10 @@ class ScanBackend {
   /// map spacing. Keeps the frame; returns its size.
   virtual std::size_t preprocess(const Scan& scan, const deskew::ScanMotion& motion, bool undistort) = 0;
   /// The per-scan frame map of the frame (sensor frame), the source cloud with its covariances,
-  /// and the mean points per frame-map voxel within `density_range_m` of the sensor.
-  virtual SourceSummary build_source(double density_range_m) = 0;
+  /// and the mean points per frame-map voxel within `density_range_m` of the sensor. Without
+  /// `covariances` (nothing to register against: an empty submap) the source has the same
+  /// points, none with a covariance.
+  virtual SourceSummary build_source(double density_range_m, bool covariances) = 0;
   /// Sparsity-aware GICP of the source against the submap.
   virtual registration::RegistrationResult register_source(const SE3& initial_guess, const registration::Thresholds& th,
                                                            const RegistrationConfig& config, double time_budget_s) = 0;
