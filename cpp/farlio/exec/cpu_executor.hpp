@@ -38,23 +38,14 @@ class CpuExecutor {
   /// `identity`. Deterministic for a given thread count and n (static partitioning).
   template <typename T, typename Map, typename Combine>
   T reduce(std::size_t n, const T& identity, const Map& map, const Combine& combine) {
-    if (n == 0) return identity;
-    T result = identity;
-    arena_.execute([&] {
-      result = tbb::parallel_deterministic_reduce(
-          tbb::blocked_range<std::size_t>(0, n, kGrain), identity,
-          [&](const tbb::blocked_range<std::size_t>& r, T acc) {
-            for (std::size_t i = r.begin(); i < r.end(); ++i) acc = combine(acc, map(i));
-            return acc;
-          },
-          combine);
-    });
-    return result;
+    return accumulate(
+        n, identity, [&](T& acc, std::size_t i) { acc = combine(acc, map(i)); }, combine);
   }
 
   /// reduce with each index's term added to its task's running sum in place: add(acc, i) does
   /// acc = acc + term(i). The same sums in the same order as reduce(n, identity, term, combine)
-  /// with combine(a, b) = a + b, without a term object per index.
+  /// with combine(a, b) = a + b, without a term object per index. The tasks' sums are combined
+  /// with `combine`.
   template <typename T, typename Add, typename Combine>
   T accumulate(std::size_t n, const T& identity, const Add& add, const Combine& combine) {
     if (n == 0) return identity;
