@@ -113,9 +113,24 @@ def test_help_documents_every_option():
         assert action.help and action.help != argparse.SUPPRESS, action.option_strings
 
 
+def test_passes_with_new_pipelines_give_the_same_poses():
+    """What FarlioRun.pool relies on to keep one pass's trajectory: a new pipeline over the same
+    scans gives the same poses, bit for bit."""
+    scans, _, _ = generated_scans(PROFILE, SCANS)
+    config = _core.Config()
+    config.set("num_threads", "2")
+    config.set("device", "cpu")
+    first, second = run_farlio(scans, config), run_farlio(scans, config)
+    assert len(first.trajectory) == len(second.trajectory) == SCANS
+    for k in range(SCANS):
+        (s1, p1), (s2, p2) = first.trajectory[k], second.trajectory[k]
+        assert s1 == s2
+        assert np.array_equal(np.asarray(p1.matrix()), np.asarray(p2.matrix())), k
+
+
 def test_rounds_pool_the_frames_of_passes_that_give_the_same_poses(tmp_path):
-    """--rounds N: N passes, each with a new pipeline; the poses of every pass are the same (the
-    accuracy and work of one pass), the frame times of all are pooled."""
+    """--rounds N: N passes, each with a new pipeline; the accuracy and work are those of one pass
+    (the passes give the same poses: the test above), the frame times of all are pooled."""
     one, two = tmp_path / "one", tmp_path / "two"
     text = io.StringIO()
     with redirect_stdout(text):
