@@ -86,6 +86,8 @@ void bind_sim(nb::module_& m) {
       .def_rw("imu_errors", &SimConfig::imu_errors)
       .def_rw("noise_free", &SimConfig::noise_free)
       .def_rw("start_stamp_ns", &SimConfig::start_stamp_ns)
+      .def_rw("motion_start_s", &SimConfig::motion_start_s,
+              "t = 0 of the sequence is this instant of the profile's motion (s; 0: at its start, at rest)")
       .def_rw("lidar_rate_hz", &SimConfig::lidar_rate_hz)
       .def_rw("imu_rate_hz", &SimConfig::imu_rate_hz)
       .def_rw("gravity_m_s2", &SimConfig::gravity_m_s2);

@@ -23,6 +23,7 @@ def make_config(
     *,
     seed: int = 1,
     duration_s: float | None = None,
+    motion_start_s: float = 0.0,
     noise_free: bool = False,
     imu_grade: str = "profile",
     vibration: bool = True,
@@ -30,11 +31,13 @@ def make_config(
 ) -> Any:
     """The profile's defaults with the given overrides: the IMU set to imu_grade (with the platform
     vibration of the datasheet grades unless vibration=False), then the noise fields by their
-    NoiseConfig name."""
+    NoiseConfig name. motion_start_s > 0 begins the sequence that far into the profile's motion (a
+    recording that starts while the body moves)."""
     cfg = _core.sim.default_config(profile)
     cfg.seed = seed
     if duration_s is not None:
         cfg.duration_s = duration_s
+    cfg.motion_start_s = motion_start_s
     cfg.noise_free = noise_free
     cfg = _core.sim.apply_imu_grade(cfg, imu_grade, vibration)
     n = cfg.noise

@@ -67,6 +67,10 @@ struct SimConfig {
   bool noise_free = false;
   /// Stamp of the sequence start (t = 0) in ns.
   std::int64_t start_stamp_ns = 0;
+  /// Where the recording begins in the profile's motion, in seconds: t = 0 of the sequence is this
+  /// instant of the motion. 0 (the default): at the profile's start, at rest; later: a recording
+  /// that begins while the body already moves (a cut bag, a node restarted at speed).
+  double motion_start_s = 0.0;
   double lidar_rate_hz = 0.0;
   double imu_rate_hz = 0.0;
   double gravity_m_s2 = 0.0;

@@ -8,6 +8,7 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 #include "farlio/core/time.hpp"
 #include "farlio/sim/imu_errors.hpp"
@@ -58,12 +59,27 @@ void add_imu_errors(const ImuErrorConfig& e, std::uint64_t seed, std::map<std::s
   d["vibration_accel_noise_std_m_s2_per_m_s"] = vec(v.accel_noise_std_m_s2_per_m_s);
   d["vibration_gyro_noise_std_rad_s_per_m_s"] = vec(v.gyro_noise_std_rad_s_per_m_s);
 }
+/// A motion that begins offset_s into another.
+class LaterStart final : public MotionModel {
+ public:
+  LaterStart(std::shared_ptr<const MotionModel> motion, double offset_s)
+      : motion_(std::move(motion)), offset_s_(offset_s) {}
+  [[nodiscard]] BodyState state(double t_s) const override { return motion_->state(t_s + offset_s_); }
+
+ private:
+  std::shared_ptr<const MotionModel> motion_;
+  double offset_s_;
+};
 }  // namespace
 
 SequenceGenerator::SequenceGenerator(const SimConfig& config)
     : config_(config), world_(std::make_shared<const World>(build_world(config.profile))) {
   if (!(config_.lidar_rate_hz > 0.0) || !(config_.imu_rate_hz > 0.0) || !(config_.duration_s > 0.0))
     throw std::invalid_argument("SimConfig: lidar_rate_hz, imu_rate_hz and duration_s must be positive");
+  if (!(config_.motion_start_s >= 0.0) || !std::isfinite(config_.motion_start_s))
+    throw std::invalid_argument("SimConfig: motion_start_s must be finite and not negative");
+  motion_ = config_.motion_start_s > 0.0 ? std::make_shared<const LaterStart>(world_->motion, config_.motion_start_s)
+                                         : world_->motion;
   validate_imu_errors(config_.imu_errors);
   period_ns_ = std::llround(kNsPerS / config_.lidar_rate_hz);
 }
@@ -81,7 +97,7 @@ double SequenceGenerator::seconds_since_start(std::int64_t stamp_ns) const {
 }
 
 BodyState SequenceGenerator::state(std::int64_t stamp_ns) const {
-  return world_->motion->state(seconds_since_start(stamp_ns));
+  return motion_->state(seconds_since_start(stamp_ns));
 }
 
 Scan SequenceGenerator::scan(std::size_t i) const {
@@ -115,7 +131,7 @@ Scan SequenceGenerator::scan(std::size_t i) const {
       const Firing& firing = firings[f];
       const LidarSensor& l = lidars[firing.sensor];
       const double t_rel_s = firing.time_fraction * period_s;
-      const SE3 T_world_lidar = world_->motion->state(start_s + t_rel_s).pose_world_body * world_->T_imu_lidar;
+      const SE3 T_world_lidar = motion_->state(start_s + t_rel_s).pose_world_body * world_->T_imu_lidar;
       const SE3 T_world_sensor = T_world_lidar * l.T_lidar_sensor;
       const Eigen::Vector3d origin = T_world_sensor.translation();
       const Mat3d R_world_sensor = T_world_sensor.rotation();
@@ -178,7 +194,7 @@ Scan SequenceGenerator::motion_compensated(const Scan& scan) const {
   return out;
 }
 
-std::vector<ImuSample> SequenceGenerator::imu() const { return generate_imu(*world_->motion, config_); }
+std::vector<ImuSample> SequenceGenerator::imu() const { return generate_imu(*motion_, config_); }
 
 Trajectory SequenceGenerator::groundtruth_body(double rate_hz) const {
   if (!(rate_hz > 0.0)) throw std::invalid_argument("groundtruth_body: rate_hz must be positive");
@@ -206,6 +222,7 @@ std::map<std::string, std::string> SequenceGenerator::description() const {
   d["seed"] = std::to_string(config_.seed);
   d["start_stamp_ns"] = std::to_string(config_.start_stamp_ns);  // t = 0 of the times in seconds
   d["duration_s"] = num(config_.duration_s);
+  d["motion_start_s"] = num(config_.motion_start_s);  // t = 0 is this instant of the profile's motion
   d["noise_free"] = config_.noise_free ? "true" : "false";
   d["lidar_rate_hz"] = num(config_.lidar_rate_hz);
   d["imu_rate_hz"] = num(config_.imu_rate_hz);
@@ -222,10 +239,10 @@ std::map<std::string, std::string> SequenceGenerator::description() const {
   // Trajectory statistics over the duration.
   double max_speed = 0.0, sum_speed = 0.0, max_lateral = 0.0, max_rate = 0.0, path_m = 0.0;
   double z_min = std::numeric_limits<double>::infinity(), z_max = -z_min;
-  Eigen::Vector3d prev = world_->motion->state(0.0).pose_world_body.translation();
+  Eigen::Vector3d prev = motion_->state(0.0).pose_world_body.translation();
   const auto count = static_cast<std::size_t>(std::floor(config_.duration_s * kStatsRate_hz)) + 1;
   for (std::size_t k = 0; k < count; ++k) {
-    const BodyState s = world_->motion->state(static_cast<double>(k) / kStatsRate_hz);
+    const BodyState s = motion_->state(static_cast<double>(k) / kStatsRate_hz);
     const double v = s.velocity_world_m_s.norm();
     max_speed = std::max(max_speed, v);
     sum_speed += v;

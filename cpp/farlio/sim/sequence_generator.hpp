@@ -2,7 +2,8 @@
 // The sequence generator: LiDAR scans and IMU samples of one profile with exact ground truth,
 // all in memory (writing files is the sequence-folder writer's job).
 //
-// Scan i covers [start + i * period, start + (i + 1) * period). Every point is the hit of a
+// Scan i covers [start + i * period, start + (i + 1) * period). Time t of the sequence is time
+// t + motion_start_s of the profile's motion (0: the profile's start, at rest). Every point is the hit of a
 // ray fired at its own instant t, expressed in the LiDAR frame at t:
 //   point = inverse(T_world_body(t) * T_imu_lidar) * hit, time_s = t - scan start.
 #include <cstdint>
@@ -59,6 +60,8 @@ class SequenceGenerator {
  private:
   SimConfig config_;
   std::shared_ptr<const World> world_;
+  /// The world's motion from config_.motion_start_s on: state(t) is the world's at t + motion_start_s.
+  std::shared_ptr<const MotionModel> motion_;
   std::int64_t period_ns_ = 0;
 };
 

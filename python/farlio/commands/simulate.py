@@ -29,6 +29,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default=None,
         help="seconds to generate (default: the profile's, docs/simulation.md)",
     )
+    parser.add_argument(
+        "--start",
+        type=non_negative_float,
+        default=0.0,
+        metavar="S",
+        help="begin the sequence S seconds into the profile's motion (default 0: at its start, at rest); later "
+        "starts record a body already moving, as a cut recording or a node restarted at speed does",
+    )
     parser.add_argument("--noise-free", action="store_true", help="exact ranges, no dropout, IMU without noise/bias")
     parser.add_argument(
         "--imu-grade",
@@ -69,6 +77,7 @@ def run(args: argparse.Namespace) -> int:
         args.profile,
         seed=args.seed,
         duration_s=args.duration,
+        motion_start_s=args.start,
         noise_free=args.noise_free,
         imu_grade=args.imu_grade,
         vibration=not args.no_vibration,
