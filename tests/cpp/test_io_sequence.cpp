@@ -171,6 +171,34 @@ TEST(Sequence, ImuBackwardsSampleDroppedWithWarning) {
   EXPECT_TRUE(found);
 }
 
+TEST(Sequence, AnImuStampFarAheadCostsOneSample) {
+  // one sample stamped 1000 s ahead (a clock glitch) is dropped, not every sample after it; one
+  // stamped behind is dropped as well, and so is one that repeats a stamp
+  TempDir tmp;
+  write_folder_with_one_scan(tmp.path());
+  std::string csv = "t_ns,gx,gy,gz,ax,ay,az\n";
+  std::vector<std::int64_t> expected;
+  for (std::int64_t k = 1; k <= 30; ++k) {
+    std::int64_t t = k * 10'000'000;
+    if (k == 10) t += 1'000'000'000'000;  // far ahead: dropped
+    if (k == 20) t = 5'000'000;           // behind: dropped
+    if (k == 25) t = 24 * 10'000'000;     // a repeated stamp: dropped
+    if (k != 10 && k != 20 && k != 25) expected.push_back(t);
+    csv += std::to_string(t) + ",0,0,0,0,0,9.81\n";
+  }
+  test::write_raw(tmp.path() / "imu.csv", csv);
+  SequenceReader r(tmp.path());
+  ASSERT_EQ(r.imu().size(), expected.size());
+  for (std::size_t i = 0; i < expected.size(); ++i) EXPECT_EQ(r.imu()[i].stamp_ns, expected[i]) << i;
+  const auto warn = r.warnings();
+  ASSERT_EQ(warn.size(), 3u);
+  EXPECT_NE(warn[0].find("imu.csv:11: sample at 1000100000000 ns is ahead of the samples after it"), std::string::npos)
+      << warn[0];
+  EXPECT_NE(warn[1].find("imu.csv:21: sample at 5000000 ns is not after the previous one"), std::string::npos)
+      << warn[1];
+  EXPECT_NE(warn[2].find("imu.csv:26"), std::string::npos) << warn[2];
+}
+
 TEST(Sequence, ImuNonFiniteSamplesDroppedWithWarnings) {
   // a sensor's NaN or inf drops its sample (named), the run goes on; text that is no number stays
   // an error naming the line

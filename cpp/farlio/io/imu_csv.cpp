@@ -6,6 +6,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string_view>
+#include <utility>
 
 #include "farlio/core/error.hpp"
 #include "farlio/io/file_bytes.hpp"
@@ -33,6 +34,61 @@ std::vector<std::string_view> split_commas(std::string_view line) {
   }
   return out;
 }
+
+/// A parsed sample and the line it came from.
+struct Row {
+  ImuSample sample;
+  std::size_t line = 0;
+};
+
+/// Keeps the samples in time order as they are read. A sample that is not after the last one kept
+/// conflicts with it, and the sample after both decides which of the two is out of place: one
+/// stamped ahead of the rest (a far-future stamp) is dropped, not every sample after it; one
+/// stamped behind is dropped. Each dropped sample is named in a warning.
+class TimeOrder {
+ public:
+  TimeOrder(const std::string& file, std::vector<std::string>& warnings) : file_(file), warnings_(warnings) {}
+
+  void add(const Row& row) {
+    if (conflict_) {
+      const Row c = *std::exchange(conflict_, std::nullopt);
+      const std::int64_t t = c.sample.stamp_ns, next = row.sample.stamp_ns;
+      const bool next_follows = next > t && next <= kept_.back().stamp_ns;
+      const bool after_the_one_before = kept_.size() < 2 || t > kept_[kept_.size() - 2].stamp_ns;
+      if (next_follows && after_the_one_before) {  // the last one kept was stamped ahead
+        drop({kept_.back(), last_line_}, "is ahead of the samples after it (" + std::to_string(t) + " ns next)");
+        kept_.back() = c.sample;
+        last_line_ = c.line;
+      } else {
+        drop(c, "is not after the previous one (" + std::to_string(kept_.back().stamp_ns) + " ns)");
+      }
+    }
+    if (kept_.empty() || row.sample.stamp_ns > kept_.back().stamp_ns) {
+      kept_.push_back(row.sample);
+      last_line_ = row.line;
+    } else {
+      conflict_ = row;
+    }
+  }
+
+  /// The samples kept (a conflict left at the end is dropped).
+  std::vector<ImuSample> finish() {
+    if (conflict_) drop(*conflict_, "is not after the previous one (" + std::to_string(kept_.back().stamp_ns) + " ns)");
+    return std::move(kept_);
+  }
+
+ private:
+  void drop(const Row& r, const std::string& why) {
+    warnings_.push_back(file_ + ":" + std::to_string(r.line) + ": sample at " + std::to_string(r.sample.stamp_ns) +
+                        " ns " + why + "; dropped");
+  }
+
+  const std::string& file_;
+  std::vector<std::string>& warnings_;
+  std::vector<ImuSample> kept_;
+  std::size_t last_line_ = 0;
+  std::optional<Row> conflict_;
+};
 
 }  // namespace
 
@@ -71,7 +127,7 @@ std::vector<ImuSample> parse_imu_csv(std::istream& in, const std::string& file, 
     if (!known) warnings.push_back(file + ": unknown column '" + std::string(name) + "' ignored");
   }
 
-  std::vector<ImuSample> samples;
+  TimeOrder samples(file, warnings);
   std::size_t non_finite_samples = 0;
   while (std::getline(in, line)) {
     ++line_no;
@@ -108,19 +164,14 @@ std::vector<ImuSample> parse_imu_csv(std::istream& in, const std::string& file, 
       }
       continue;
     }
-    if (!samples.empty() && s.stamp_ns <= samples.back().stamp_ns) {
-      warnings.push_back(where + ": sample at " + std::to_string(s.stamp_ns) + " ns is not after the previous one (" +
-                         std::to_string(samples.back().stamp_ns) + " ns); dropped");
-      continue;
-    }
-    samples.push_back(s);
+    samples.add({s, line_no});
   }
   if (non_finite_samples > kNamedNonFiniteSamples) {
     warnings.push_back(file + ": " + std::to_string(non_finite_samples) +
                        " samples with a nan or inf value dropped in all (the first " +
                        std::to_string(kNamedNonFiniteSamples) + " named above)");
   }
-  return samples;
+  return samples.finish();
 }
 
 void write_imu_csv(const std::filesystem::path& path, const std::vector<ImuSample>& samples) {
