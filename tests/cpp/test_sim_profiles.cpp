@@ -190,6 +190,37 @@ TEST(SimProfiles, VelocityIsTheDerivativeOfPosition) {
   }
 }
 
+TEST(SimProfiles, ALaterStartIsTheSameMotionFromThatInstant) {
+  // motion_start_s = 12: t = 0 of the sequence is t = 12 of the profile (the racetrack at 70 m/s),
+  // for the states, the ideal IMU and the scan-end ground truth; a negative start is refused
+  SimConfig whole = default_config(Profile::Racetrack), cut = whole;
+  whole.noise_free = cut.noise_free = true;
+  whole.duration_s = 13.0;
+  cut.duration_s = 1.0;
+  cut.motion_start_s = 12.0;
+  const SequenceGenerator a(whole), b(cut);
+  const std::int64_t offset_ns = 12'000'000'000;
+  for (const double t : {0.0, 0.37, 1.0}) {
+    const std::int64_t stamp = cut.start_stamp_ns + std::llround(t * 1e9);
+    const BodyState sa = a.state(stamp + offset_ns), sb = b.state(stamp);
+    EXPECT_LT((sa.pose_world_body.translation() - sb.pose_world_body.translation()).norm(), 1e-9);
+    EXPECT_LT((sa.velocity_world_m_s - sb.velocity_world_m_s).norm(), 1e-9);
+  }
+  EXPECT_NEAR(b.state(cut.start_stamp_ns).velocity_world_m_s.norm(), 70.0, 0.1);
+  const auto imu_a = a.imu(), imu_b = b.imu();
+  const std::size_t per_s = static_cast<std::size_t>(whole.imu_rate_hz);
+  for (std::size_t k = 0; k < imu_b.size(); k += 97) {
+    EXPECT_LT((imu_a[12 * per_s + k].accel_m_s2 - imu_b[k].accel_m_s2).norm(), 1e-9) << k;
+    EXPECT_LT((imu_a[12 * per_s + k].gyro_rad_s - imu_b[k].gyro_rad_s).norm(), 1e-9) << k;
+  }
+  const auto gt_b = b.groundtruth_scans();
+  EXPECT_LT((gt_b[0].pose.translation() - a.state(gt_b[0].stamp_ns + offset_ns).pose_world_body.translation()).norm(),
+            1e-9);
+  EXPECT_EQ(b.description().at("motion_start_s"), "12");
+  cut.motion_start_s = -1.0;
+  EXPECT_THROW(SequenceGenerator{cut}, std::invalid_argument);
+}
+
 TEST(SimConfigApi, ParseProfile) {
   EXPECT_EQ(parse_profile("racetrack"), Profile::Racetrack);
   EXPECT_EQ(parse_profile("urban"), Profile::Urban);
