@@ -30,8 +30,15 @@ using namespace nb::literals;
 namespace farlio::python {
 namespace {
 
+// Thread-safety of the bound classes (docs/hardening.md): the methods that release the GIL work on
+// state no other call may touch meanwhile, so Odometry, ScanPipeline and MapExport hold a mutex
+// of their own in every method; it is taken after the GIL is released (a thread waiting for it
+// never blocks Python) and nothing called under it needs the GIL. OnlineOdometry is thread-safe
+// itself. The other classes keep the GIL in every method.
+
 /// Odometry with its 10 ms output collected between calls (no Python callback on the hot path).
 struct PyOdometry {
+  std::mutex mutex;
   std::vector<pipeline::OdometrySample> pending;
   pipeline::Odometry odometry;
   PyOdometry(const Config& c, const SE3& T, double g, std::vector<ImuSample> imu, const pipeline::ReplayOptions& o)
@@ -39,6 +46,28 @@ struct PyOdometry {
     odometry.on_odometry = [this](const pipeline::OdometrySample& s) { pending.push_back(s); };
   }
 };
+
+/// A scan pipeline and the mutex its calls take.
+struct PyScanPipeline {
+  std::mutex mutex;
+  pipeline::ScanPipeline pipeline;
+  PyScanPipeline(const Config& c, const SE3& initial_pose) : pipeline(c, initial_pose) {}
+};
+
+/// A map export and the mutex its calls take.
+struct PyMapExport {
+  std::mutex mutex;
+  pipeline::MapExport map;
+  PyMapExport(double resolution_m, const Config& config, const std::string& spill_dir)
+      : map(resolution_m, config.preprocess, config.num_threads, spill_dir, config.map.export_tile_m) {}
+};
+
+/// Calls f(object) holding the object's mutex.
+template <typename T, typename F>
+auto locked(T& o, F&& f) {
+  std::lock_guard lock(o.mutex);
+  return f(o);
+}
 
 /// The online odometry with its outputs collected for polling: the worker thread never calls
 /// into Python (and so never needs the GIL).
@@ -213,6 +242,11 @@ void bind_pipeline(nb::module_& m) {
               "why the registration's pose was not used (empty: it was); the scan kept the prediction")
       .def_ro("map_restarted", &pipeline::FrameResult::map_restarted,
               "the map restarted from this scan after registration failures (recovery)")
+      .def_ro("non_finite_points", &pipeline::FrameResult::non_finite_points,
+              "points dropped before the preprocessing for NaN or Inf coordinates or times")
+      .def_ro("map_started_here", &pipeline::FrameResult::map_started_here,
+              "the first registration found the body moving: this scan was undistorted again with that motion and "
+              "the map started again from it")
       .def_ro("inlier_fraction", &pipeline::FrameResult::inlier_fraction,
               "inliers over source points of the registration (0 when not registered)")
       .def_ro("lost", &pipeline::FrameResult::lost,
@@ -314,11 +348,29 @@ void bind_pipeline(nb::module_& m) {
           "(OnlineOdometry with keep_registered_points; else empty)")
       .def("__repr__", attribute_repr({"processed", "fused", "drop_reason", "started_ns", "available_ns",
                                        "guess_from_fusion", "body_pose", "scan"}));
+  nb::class_<fusion::InitializationReport>(m, "InitializationReport",
+                                           "How and when the filter was first initialised (fusion/initialization.hpp)")
+      .def_ro("initialized", &fusion::InitializationReport::initialized)
+      .def_ro("mode", &fusion::InitializationReport::mode, "'standstill' or 'in motion' ('' before)")
+      .def_ro("stamp_ns", &fusion::InitializationReport::stamp_ns, "the LiDAR result that initialised it")
+      .def_ro("window_poses", &fusion::InitializationReport::window_poses, "LiDAR poses aligned with the IMU")
+      .def_ro("window_s", &fusion::InitializationReport::window_s, "their time span")
+      .def_ro("speed_m_s", &fusion::InitializationReport::speed_m_s, "the speed found")
+      .def_ro("up_map", &fusion::InitializationReport::up_map, "the up direction (against gravity) in the map frame")
+      .def_ro("map_tilt_deg", &fusion::InitializationReport::map_tilt_deg,
+              "angle between the map frame's z axis and up (0: the map frame is level)")
+      .def_ro("gravity_norm_error", &fusion::InitializationReport::gravity_norm_error,
+              "| |g| estimated freely - g | / g over the window: how consistent its data were")
+      .def("__repr__", attribute_repr({"mode", "stamp_ns", "window_poses", "window_s", "speed_m_s", "map_tilt_deg",
+                                       "gravity_norm_error"}));
   nb::class_<fusion::FusionStats>(m, "FusionStats")
       .def_ro("steps", &fusion::FusionStats::steps)
       .def_ro("lidar_groups_accepted", &fusion::FusionStats::lidar_groups_accepted)
       .def_ro("lidar_groups_rejected", &fusion::FusionStats::lidar_groups_rejected)
       .def_ro("reinitializations", &fusion::FusionStats::reinitializations)
+      .def_ro("initialization", &fusion::FusionStats::initialization)
+      .def_ro("up_map", &fusion::FusionStats::up_map,
+              "the up direction (against gravity) in the map frame as the filter now estimates it")
       .def_ro("imu_gaps", &fusion::FusionStats::imu_gaps)
       .def_ro("imu_samples_dropped", &fusion::FusionStats::imu_samples_dropped)
       .def_ro("imu_samples_rejected", &fusion::FusionStats::imu_samples_rejected,
@@ -332,99 +384,137 @@ void bind_pipeline(nb::module_& m) {
                                        "imu_gaps", "imu_samples_dropped", "imu_samples_rejected", "accel_in_g",
                                        "gyro_bias_rad_s", "last_warning"}));
   nb::class_<PyOdometry>(m, "Odometry",
-                         "LiDAR-inertial odometry replayed on a simulated clock (LiDAR-only without IMU).")
+                         "LiDAR-inertial odometry replayed on a simulated clock (LiDAR-only without IMU). Calls from "
+                         "several threads run one at a time (scans must still come in time order).")
       .def(nb::init<const Config&, const SE3&, double, std::vector<ImuSample>, const pipeline::ReplayOptions&>(),
            "config"_a, "T_imu_lidar"_a, "gravity_m_s2"_a, "imu"_a, "options"_a = pipeline::ReplayOptions())
       .def(
-          "process", [](PyOdometry& o, const Scan& s) { return o.odometry.process(s); }, "scan"_a,
-          nb::call_guard<nb::gil_scoped_release>())
+          "process",
+          [](PyOdometry& o, const Scan& s) { return locked(o, [&](PyOdometry& x) { return x.odometry.process(s); }); },
+          "scan"_a, nb::call_guard<nb::gil_scoped_release>())
       .def(
-          "finish", [](PyOdometry& o, std::int64_t t) { o.odometry.finish(t); }, "stamp_ns"_a,
-          nb::call_guard<nb::gil_scoped_release>())
+          "finish", [](PyOdometry& o, std::int64_t t) { locked(o, [&](PyOdometry& x) { x.odometry.finish(t); }); },
+          "stamp_ns"_a, nb::call_guard<nb::gil_scoped_release>())
       .def(
           "take_odometry",
           [](PyOdometry& o) {
-            std::vector<std::pair<std::int64_t, SE3>> out;
-            for (const auto& s : o.pending) out.emplace_back(s.stamp_ns, s.body_pose);
-            o.pending.clear();
-            return out;
+            return locked(o, [](PyOdometry& x) {
+              std::vector<std::pair<std::int64_t, SE3>> out;
+              for (const auto& s : x.pending) out.emplace_back(s.stamp_ns, s.body_pose);
+              x.pending.clear();
+              return out;
+            });
           },
+          nb::call_guard<nb::gil_scoped_release>(),
           "[(stamp_ns, body pose)] of the 10 ms odometry output since the last call.")
       .def(
-          "set_initial_pose", [](PyOdometry& o, const SE3& pose) { o.odometry.set_initial_pose(pose); }, "body_pose"_a,
+          "set_initial_pose",
+          [](PyOdometry& o, const SE3& pose) { locked(o, [&](PyOdometry& x) { x.odometry.set_initial_pose(pose); }); },
+          "body_pose"_a, nb::call_guard<nb::gil_scoped_release>(),
           "The body pose at the first scan in the world (the prior map's frame): position and yaw as given; roll "
           "and pitch too when LiDAR-only, from gravity when inertial. Before the first scan.")
       .def(
-          "set_prior_map", [](PyOdometry& o, const Scan& map) { o.odometry.set_prior_map(map.points); }, "map"_a,
+          "set_prior_map",
+          [](PyOdometry& o, const Scan& map) {
+            locked(o, [&](PyOdometry& x) { x.odometry.set_prior_map(map.points); });
+          },
+          "map"_a, nb::call_guard<nb::gil_scoped_release>(),
           "Localization: the submap is built from the points of `map` (world frame) and held fixed. Before the "
           "first scan.")
-      .def_prop_ro("localizing", [](const PyOdometry& o) { return o.odometry.scan_pipeline().localizing(); })
-      .def_prop_ro("inertial", [](const PyOdometry& o) { return o.odometry.inertial(); })
+      .def_prop_ro("localizing",
+                   [](PyOdometry& o) {
+                     return locked(o, [](PyOdometry& x) { return x.odometry.scan_pipeline().localizing(); });
+                   })
+      .def_prop_ro("inertial",
+                   [](PyOdometry& o) { return locked(o, [](PyOdometry& x) { return x.odometry.inertial(); }); })
       .def(
-          "take_warnings", [](PyOdometry& o) { return o.odometry.take_warnings(); },
+          "take_warnings",
+          [](PyOdometry& o) { return locked(o, [](PyOdometry& x) { return x.odometry.take_warnings(); }); },
+          nb::call_guard<nb::gil_scoped_release>(),
           "What was tolerated since the last call (sorted IMU, an unusable IMU, a reset of the fusion).")
       .def_prop_ro(
-          "effective_config", [](const PyOdometry& o) { return o.odometry.scan_pipeline().config(); },
+          "effective_config",
+          [](PyOdometry& o) { return locked(o, [](PyOdometry& x) { return x.odometry.scan_pipeline().config(); }); },
           "The parameters in use (the voxel size is fixed at the first scan when auto).")
-      .def_prop_ro("fusion_stats", [](const PyOdometry& o) { return o.odometry.fusion_stats(); })
-      .def_prop_ro("initial_body_pose", [](const PyOdometry& o) { return o.odometry.initial_body_pose(); })
+      .def_prop_ro("fusion_stats",
+                   [](PyOdometry& o) { return locked(o, [](PyOdometry& x) { return x.odometry.fusion_stats(); }); })
+      .def_prop_ro(
+          "initial_body_pose",
+          [](PyOdometry& o) { return locked(o, [](PyOdometry& x) { return x.odometry.initial_body_pose(); }); })
       .def(
           "map_points",
-          [](const PyOdometry& o) { return map_points(o.odometry.scan_pipeline().backend().map_snapshot()); },
+          [](PyOdometry& o) {
+            const map::MapSnapshot snapshot = [&] {
+              nb::gil_scoped_release unlocked;
+              return locked(o, [](PyOdometry& x) { return x.odometry.scan_pipeline().backend().map_snapshot(); });
+            }();
+            return map_points(snapshot);
+          },
           "(N, 3) float32 copy of the submap's points (world frame)")
       .def_prop_ro("map_memory_bytes",
-                   [](const PyOdometry& o) { return o.odometry.scan_pipeline().backend().memory_bytes(); })
+                   [](PyOdometry& o) {
+                     return locked(o,
+                                   [](PyOdometry& x) { return x.odometry.scan_pipeline().backend().memory_bytes(); });
+                   })
       .def_prop_ro(
-          "device", [](const PyOdometry& o) { return device_name(o.odometry.scan_pipeline().backend().device()); },
+          "device",
+          [](PyOdometry& o) {
+            return device_name(locked(o, [](PyOdometry& x) { return x.odometry.scan_pipeline().backend().device(); }));
+          },
           "'cpu' or 'cuda': the backend the scan pipeline runs on")
       .def_prop_ro(
-          "device_message", [](const PyOdometry& o) { return o.odometry.scan_pipeline().device_message(); },
+          "device_message",
+          [](PyOdometry& o) {
+            return locked(o, [](PyOdometry& x) { return x.odometry.scan_pipeline().device_message(); });
+          },
           "why device auto fell back to the CPU ('' when it did not)");
 
   m.def("export_resolution_m", &pipeline::export_resolution_m, "config"_a,
         "map.export_resolution_m, or the map's point spacing when 0 (after the first scan fixed the voxel size, "
         "pass the effective config)");
-  nb::class_<pipeline::MapExport>(m, "MapExport",
-                                  "The whole map of a run: every used scan, undistorted, at its pose, one centroid "
-                                  "(with the mean intensity) per cell of resolution_m; with a spill folder only the "
-                                  "tiles around the sensor stay in memory.")
-      .def(
-          "__init__",
-          [](pipeline::MapExport* self, double resolution_m, const Config& config, const std::string& spill_dir) {
-            new (self) pipeline::MapExport(resolution_m, config.preprocess, config.num_threads, spill_dir,
-                                           config.map.export_tile_m);
-          },
-          "resolution_m"_a, "config"_a, "spill_dir"_a = "",
-          "spill_dir: a folder where tiles of map.export_tile_m the sensor has left wait until the end "
-          "(memory bounded by the tiles around the sensor); '': all in memory")
+  nb::class_<PyMapExport>(m, "MapExport",
+                          "The whole map of a run: every used scan, undistorted, at its pose, one centroid "
+                          "(with the mean intensity) per cell of resolution_m; with a spill folder only the "
+                          "tiles around the sensor stay in memory. Calls from several threads run one at a time.")
+      .def(nb::init<double, const Config&, const std::string&>(), "resolution_m"_a, "config"_a, "spill_dir"_a = "",
+           "spill_dir: a folder where tiles of map.export_tile_m the sensor has left wait until the end "
+           "(memory bounded by the tiles around the sensor); '': all in memory")
       .def(
           "add",
-          [](pipeline::MapExport& e, const Scan& scan, const pipeline::FrameResult& r) {
-            return e.add(scan, r.motion, r.undistorted, r.pose);
+          [](PyMapExport& e, const Scan& scan, const pipeline::FrameResult& r) {
+            return locked(e, [&](PyMapExport& x) { return x.map.add(scan, r.motion, r.undistorted, r.pose); });
           },
           "scan"_a, "result"_a, nb::call_guard<nb::gil_scoped_release>(),
           "Adds a processed scan at its pose with the motion it was undistorted with; returns the points added.")
-      .def("points", &pipeline::MapExport::points, nb::call_guard<nb::gil_scoped_release>(),
-           "The whole map as one Scan (in memory): one point per cell (centroid, mean intensity).")
+      .def(
+          "points", [](PyMapExport& e) { return locked(e, [](PyMapExport& x) { return x.map.points(); }); },
+          nb::call_guard<nb::gil_scoped_release>(),
+          "The whole map as one Scan (in memory): one point per cell (centroid, mean intensity).")
       .def(
           "write",
-          [](const pipeline::MapExport& e, const std::vector<std::filesystem::path>& paths) {
-            std::vector<io::PointStreamWriter> writers;
-            writers.reserve(paths.size());
-            for (const auto& p : paths) writers.emplace_back(p, e.cells());
-            e.for_each_piece([&](std::span<const Vec3f> points, std::span<const float> intensity) {
-              for (auto& w : writers) w.append(points, intensity);
+          [](PyMapExport& e, const std::vector<std::filesystem::path>& paths) {
+            locked(e, [&](PyMapExport& x) {
+              std::vector<io::PointStreamWriter> writers;
+              writers.reserve(paths.size());
+              for (const auto& p : paths) writers.emplace_back(p, x.map.cells());
+              x.map.for_each_piece([&](std::span<const Vec3f> points, std::span<const float> intensity) {
+                for (auto& w : writers) w.append(points, intensity);
+              });
+              for (auto& w : writers) w.close();
             });
-            for (auto& w : writers) w.close();
           },
           "paths"_a, nb::call_guard<nb::gil_scoped_release>(),
           "Streams the whole map, tile by tile, into each file (.pcd binary or .ply binary; x y z intensity).")
-      .def_prop_ro("cells", &pipeline::MapExport::cells)
-      .def_prop_ro("cells_in_memory", &pipeline::MapExport::cells_in_memory)
-      .def_prop_ro("tiles_on_disk", &pipeline::MapExport::tiles_on_disk)
-      .def_prop_ro("points_added", &pipeline::MapExport::points_added)
-      .def_prop_ro("resolution_m", &pipeline::MapExport::resolution_m)
-      .def_prop_ro("memory_bytes", &pipeline::MapExport::memory_bytes);
+      .def_prop_ro("cells", [](PyMapExport& e) { return locked(e, [](PyMapExport& x) { return x.map.cells(); }); })
+      .def_prop_ro("cells_in_memory",
+                   [](PyMapExport& e) { return locked(e, [](PyMapExport& x) { return x.map.cells_in_memory(); }); })
+      .def_prop_ro("tiles_on_disk",
+                   [](PyMapExport& e) { return locked(e, [](PyMapExport& x) { return x.map.tiles_on_disk(); }); })
+      .def_prop_ro("points_added",
+                   [](PyMapExport& e) { return locked(e, [](PyMapExport& x) { return x.map.points_added(); }); })
+      .def_prop_ro("resolution_m", [](PyMapExport& e) { return e.map.resolution_m(); })
+      .def_prop_ro("memory_bytes",
+                   [](PyMapExport& e) { return locked(e, [](PyMapExport& x) { return x.map.memory_bytes(); }); });
 
   nb::class_<pipeline::OdometrySample>(m, "OdometrySample", "One 10 ms sample of the fused odometry.")
       .def_ro("stamp_ns", &pipeline::OdometrySample::stamp_ns)
@@ -487,26 +577,44 @@ void bind_pipeline(nb::module_& m) {
           "The fusion's counters and gyro bias (None before the first scan or LiDAR-only).")
       .def_prop_ro("scans_dropped_busy", [](PyOnlineOdometry& o) { return o.odometry.scans_dropped_busy(); });
 
-  nb::class_<pipeline::ScanPipeline>(m, "ScanPipeline",
-                                     "preprocess -> sparsity-aware GICP against the adaptive submap -> map update")
+  nb::class_<PyScanPipeline>(m, "ScanPipeline",
+                             "preprocess -> sparsity-aware GICP against the adaptive submap -> map update. Calls from "
+                             "several threads run one at a time (scans must still come in time order).")
       .def(nb::init<const Config&, const SE3&>(), "config"_a = Config(), "initial_pose"_a = SE3())
       .def(
           "process",
-          [](pipeline::ScanPipeline& p, const Scan& scan, const std::optional<SE3>& guess) {
-            return p.process(scan, guess);
+          [](PyScanPipeline& p, const Scan& scan, const std::optional<SE3>& guess) {
+            return locked(p, [&](PyScanPipeline& x) { return x.pipeline.process(scan, guess); });
           },
           "scan"_a, "initial_guess"_a = nb::none(), nb::call_guard<nb::gil_scoped_release>(),
-          "Registers one scan; without a guess the constant-velocity model supplies one.")
-      .def_prop_ro("frames", &pipeline::ScanPipeline::frames)
+          "Registers one scan; without a guess the constant-velocity model supplies one. Points with NaN or Inf "
+          "coordinates or times are dropped (FrameResult.non_finite_points).")
+      .def_prop_ro("frames",
+                   [](PyScanPipeline& p) { return locked(p, [](PyScanPipeline& x) { return x.pipeline.frames(); }); })
       .def(
-          "map_points", [](const pipeline::ScanPipeline& p) { return map_points(p.backend().map_snapshot()); },
+          "map_points",
+          [](PyScanPipeline& p) {
+            const map::MapSnapshot snapshot = [&] {
+              nb::gil_scoped_release unlocked;
+              return locked(p, [](PyScanPipeline& x) { return x.pipeline.backend().map_snapshot(); });
+            }();
+            return map_points(snapshot);
+          },
           "(N, 3) float32 copy of the submap's points (world frame)")
-      .def_prop_ro("map_memory_bytes", [](const pipeline::ScanPipeline& p) { return p.backend().memory_bytes(); })
+      .def_prop_ro("map_memory_bytes",
+                   [](PyScanPipeline& p) {
+                     return locked(p, [](PyScanPipeline& x) { return x.pipeline.backend().memory_bytes(); });
+                   })
       .def_prop_ro(
-          "device", [](const pipeline::ScanPipeline& p) { return device_name(p.backend().device()); },
+          "device",
+          [](PyScanPipeline& p) {
+            return device_name(locked(p, [](PyScanPipeline& x) { return x.pipeline.backend().device(); }));
+          },
           "'cpu' or 'cuda': the backend the stages run on")
-      .def_prop_ro("device_message", &pipeline::ScanPipeline::device_message,
-                   "why device auto fell back to the CPU ('' when it did not)");
+      .def_prop_ro(
+          "device_message",
+          [](PyScanPipeline& p) { return locked(p, [](PyScanPipeline& x) { return x.pipeline.device_message(); }); },
+          "why device auto fell back to the CPU ('' when it did not)");
 }
 
 }  // namespace farlio::python

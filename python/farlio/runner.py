@@ -31,6 +31,7 @@ import numpy as np
 
 import farlio
 from farlio import _core
+from farlio._core import NS_PER_S
 
 from .config import config_to_yaml
 from .datasets import Dataset
@@ -122,7 +123,8 @@ class FrameCounts:
     fused: int = 0
     converged: int = 0
     skipped: int = 0
-    dropped: int = 0
+    dropped: int = 0  # not processed: the pipeline was busy
+    not_fused: int = 0  # processed, its result not fused (timing.csv drop_reason: a failure, no IMU yet, ...)
     degenerate: int = 0  # registered frames with a degenerate direction
     failed: int = 0  # registrations whose pose was not used (too few inliers, non-finite)
     map_restarts: int = 0  # the map restarted after failures (recovery)
@@ -289,7 +291,7 @@ class OdometryRun:
         self.counts.map_restarts += int(r.map_restarted)
         self.counts.lost += int(r.lost)
         self.counts.last_lost = r.lost
-        self.counts.dropped += int(bool(fr.drop_reason))
+        self.counts.not_fused += int(self.odo.inertial and bool(fr.drop_reason))
         self.counts.degenerate += int(fr.degeneracy is not None and fr.degeneracy.degenerate)
 
     def summarise(self) -> dict[str, Any]:
@@ -303,6 +305,7 @@ class OdometryRun:
             "dropped": c.dropped,
             "registered": c.registered,
             "fused": c.fused,
+            "not_fused": c.not_fused,
             "degenerate": c.degenerate,
             "registration_failed": c.failed,
             "map_restarts": c.map_restarts,
@@ -322,6 +325,9 @@ class OdometryRun:
         stats = self.odo.fusion_stats
         if stats is not None:
             summary["fusion"] = _fusion_summary(stats)
+            init = summary["fusion"]["initialization"]
+            if init["stamp_ns"] is not None and len(self.lidar_poses):
+                init["after_first_scan_s"] = (init["stamp_ns"] - self.lidar_poses[0][0]) / NS_PER_S
         if self.maps.prior_map is not None:
             summary["localization"] = {
                 "prior_map": str(self.maps.prior_map),
@@ -386,7 +392,20 @@ def _fusion_summary(stats: Any) -> dict[str, Any]:
             f"{stats.imu_samples_rejected} IMU sample(s) rejected as non-finite, impossible or spikes "
             f"(fusion.imu_max_*, fusion.imu_spike_*); the last: {stats.last_warning}"
         )
+    init = stats.initialization
+    up = np.asarray(stats.up_map, dtype=float)
     return {
+        # how the filter started: at rest, or in motion from the LiDAR results of its first scans
+        "initialization": {
+            "mode": init.mode or None,
+            "stamp_ns": init.stamp_ns if init.initialized else None,
+            "window_s": init.window_s,
+            "window_scans": init.window_poses,
+            "speed_m_s": init.speed_m_s,
+            "gravity_norm_error": init.gravity_norm_error,
+        },
+        # the output frame's z axis against up, as the filter estimates it at the end
+        "world_tilt_deg": math.degrees(math.acos(max(-1.0, min(1.0, float(up[2]))))),
         "lidar_groups_accepted": stats.lidar_groups_accepted,
         "lidar_groups_rejected": stats.lidar_groups_rejected,
         "reinitializations": stats.reinitializations,
@@ -421,6 +440,16 @@ def format_summary(s: dict[str, Any]) -> str:
             f"registration failed on {s['registration_failed']} scans (kept the prediction; timing.csv drop_reason), "
             f"map restarts {s.get('map_restarts', 0)}"
         )
+    init = s.get("fusion", {}).get("initialization")
+    if init is not None:
+        if init["mode"] is None:
+            lines.append("fusion: never initialised (no LiDAR results with the IMU between them)")
+        else:
+            tilt = s["fusion"]["world_tilt_deg"]
+            lines.append(
+                f"fusion: initialised {init['mode']}, {init.get('after_first_scan_s', 0.0):.2f} s after the first scan "
+                f"({init['window_scans']} scans, {init['speed_m_s']:.1f} m/s); world z {tilt:.1f} deg from up"
+            )
     loc = s.get("localization")
     if loc:
         lines.append(

@@ -76,8 +76,7 @@ struct SimResult {
   }
 };
 
-/// Runs the fusion from the true state at t = 0 (the first LiDAR result carries the true pose
-/// and velocity) to duration_s.
+/// Runs the fusion from the true state at t = 0 (SensorFusion::initialize_known) to duration_s.
 inline SimResult simulate(const TestTrajectory& traj, const FusionConfig& config, const SimOptions& o,
                           fusion::SensorFusion* fusion_out = nullptr) {
   std::mt19937 rng(o.seed);
@@ -89,7 +88,7 @@ inline SimResult simulate(const TestTrajectory& traj, const FusionConfig& config
   SimResult r;
   const double imu_dt = 1.0 / o.imu_hz, clock_dt = 1.0 / o.clock_hz;
   int imu_k = 0;
-  int lidar_k = 0;  // next LiDAR result index (0 = the initialising one)
+  int lidar_k = 0;  // next LiDAR result index (0 = the initialisation with the true state)
   const int clock_steps = static_cast<int>(std::llround(o.duration_s * o.clock_hz));
   for (int c = 0; c <= clock_steps; ++c) {
     const double now = c * clock_dt;
@@ -108,7 +107,7 @@ inline SimResult simulate(const TestTrajectory& traj, const FusionConfig& config
       const double delivered = stamp + (lidar_k == 0 ? 0.0 : o.lidar_delay_s);
       if ((lidar_k > 0 && o.lidar_hz <= 0.0) || delivered > now + 1e-12) break;
       if (lidar_k == 0) {
-        f.add_lidar(seconds_to_ns(0.0), traj.pose(0.0), traj.velocity_body(0.0), true);
+        f.initialize_known(seconds_to_ns(0.0), traj.pose(0.0), traj.velocity_body(0.0));
       } else {
         const SE3 truth = traj.pose(stamp);
         Eigen::Vector3d p = truth.translation() + noise3(o.lidar_position_noise_m);

@@ -21,6 +21,8 @@ Scan make_scan(int k, double period_s) {
   return test::scene_scan(truth_at(t), t, period_s, 80000, 100 + static_cast<unsigned>(k), 0.01f);
 }
 
+double translation_error_m(const SE3& a, const SE3& b) { return (a.inverse() * b).translation().norm(); }
+
 }  // namespace
 
 TEST(ScanPipeline, TracksAKnownTrajectory) {
@@ -82,6 +84,34 @@ TEST(ScanPipeline, EmptyAndDegenerateScansDoNotCrash) {
   EXPECT_TRUE(r1.pose.translation().allFinite());
 }
 
+TEST(ScanPipeline, PointsWithNonFiniteTimesAreDroppedAsTheReadersDo) {
+  // a scan handed to the API with NaN or Inf per-point times (the readers drop such points):
+  // those points are dropped and counted, and the pose is that of the scan without them
+  const double period = 0.1;
+  Config cfg = Config{};
+  cfg.num_threads = 2;
+  cfg.registration.time_budget_factor = 1e6;
+  pipeline::ScanPipeline with_bad(cfg, truth_at(period)), clean(cfg, truth_at(period));
+  for (int k = 0; k < 4; ++k) {
+    Scan scan = make_scan(k, period);
+    scan.start_stamp_ns = scan.end_stamp_ns - seconds_to_ns(period);
+    for (std::size_t i = 0; i < scan.size(); ++i) scan.time_s.push_back(static_cast<float>(period * i / scan.size()));
+    Scan bad = scan;
+    std::size_t marked = 0;
+    for (std::size_t i = k; i < bad.size(); i += 97, ++marked) {
+      bad.time_s[i] = (i % 2 == 0) ? std::numeric_limits<float>::quiet_NaN() : std::numeric_limits<float>::infinity();
+    }
+    Scan dropped = bad;
+    ASSERT_EQ(dropped.remove_non_finite(), marked);
+    const auto r = with_bad.process(bad);
+    const auto c = clean.process(dropped);
+    EXPECT_EQ(r.non_finite_points, marked);
+    EXPECT_EQ(r.input_points, scan.size());
+    EXPECT_TRUE(r.pose.translation().allFinite());
+    EXPECT_LT(translation_error_m(r.pose, c.pose), 1e-9) << "frame " << k;
+  }
+}
+
 namespace {
 
 /// A scan at frame k's stamps whose points are `points` (sensor frame).
@@ -90,8 +120,6 @@ Scan scan_with_points(int k, double period_s, std::vector<Eigen::Vector3f> point
   s.points = std::move(points);
   return s;
 }
-
-double translation_error_m(const SE3& a, const SE3& b) { return (a.inverse() * b).translation().norm(); }
 
 }  // namespace
 

@@ -281,12 +281,25 @@ def test_an_interrupted_run_keeps_its_summary_and_kitti_poses(sequence, tmp_path
 
 
 def test_online_warns_about_a_far_future_imu_stamp():
-    online = core.OnlineOdometry(core.Config(), core.SE3(), 9.81)
+    """A sample 10,000 s ahead waits for the next: one that follows the others shows the stamp alone
+    was wrong (the sample is dropped); two that follow it show the clock jumped (the fusion resets)."""
     t0 = 1_700_000_000_000_000_000
-    for k in range(5):
-        online.add_imu(core.ImuSample(t0 + k * 10_000_000, np.zeros(3), GRAVITY_UP))
-    online.add_imu(core.ImuSample(t0 + 10_000 * 1_000_000_000, np.zeros(3), GRAVITY_UP))
-    warnings = online.take_warnings()
-    assert any("jumps by 9999.960 s" in w and "fusion.max_bridged_gap_s" in w for w in warnings), warnings
-    assert online.take_warnings() == []
-    assert len(online.take_odometry()) == 0
+    future = t0 + 10_000 * 1_000_000_000
+    for followed_by, expected in (
+        ([t0 + 50_000_000], "from the samples around it: dropped"),
+        (
+            [future + 10_000_000, future + 20_000_000],
+            "the fusion is reset",
+        ),
+    ):
+        online = core.OnlineOdometry(core.Config(), core.SE3(), 9.81)
+        for k in range(5):
+            online.add_imu(core.ImuSample(t0 + k * 10_000_000, np.zeros(3), GRAVITY_UP))
+        online.add_imu(core.ImuSample(future, np.zeros(3), GRAVITY_UP))
+        assert online.take_warnings() == []  # held until the next sample
+        for stamp in followed_by:
+            online.add_imu(core.ImuSample(stamp, np.zeros(3), GRAVITY_UP))
+        warnings = online.take_warnings()
+        assert any("jumps by 9999.960 s" in w and expected in w for w in warnings), warnings
+        assert online.take_warnings() == []
+        assert len(online.take_odometry()) == 0

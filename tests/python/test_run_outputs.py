@@ -26,6 +26,7 @@ SUMMARY_KEYS = [
     "dropped",
     "registered",
     "fused",
+    "not_fused",
     "degenerate",
     "registration_failed",
     "map_restarts",

@@ -192,15 +192,16 @@ inline constexpr double kMaxThreads = 1024.0;
         "position std at initialisation (the first LiDAR pose)")                                                      \
   FIELD(double, initial_attitude_std_rad, 0.02, range::positive_up_to(kMaxSiValue),                                   \
         "roll/pitch/yaw std at initialisation")                                                                       \
-  FIELD(double, initial_velocity_std_m_s, 20.0, range::positive_up_to(kMaxSiValue),                                   \
-        "velocity std at initialisation when the first LiDAR result carries no velocity")                             \
+  FIELD(double, init_window_s, 0.5, range::positive_up_to(kMaxDuration_s),                                            \
+        "the filter starts from the LiDAR results of its first scans and the IMU between them: at rest from two, in " \
+        "motion from those of this span (gravity in the map frame and the velocity, fusion/initialization.hpp)")      \
   FIELD(double, lidar_position_std_m, 0.05, range::positive_up_to(kMaxSiValue),                                       \
         "LiDAR position measurement std per axis")                                                                    \
   FIELD(double, lidar_roll_pitch_std_rad, 0.02, range::positive_up_to(kMaxSiValue),                                   \
         "LiDAR roll and pitch measurement std")                                                                       \
   FIELD(double, lidar_yaw_std_rad, 0.01, range::positive_up_to(kMaxSiValue), "LiDAR yaw measurement std")             \
   FIELD(double, lidar_velocity_std_m_s, 0.8, range::positive_up_to(kMaxSiValue),                                      \
-        "LiDAR body velocity (eq. 6) measurement std per axis")                                                       \
+        "LiDAR body velocity (eq. 6) measurement std per axis, and the velocity's std at initialisation")             \
   FIELD(bool, lidar_information_from_registration, true, range::unchecked(),                                          \
         "the LiDAR pose is fused with its registration's covariance (registration.covariance_scale * H^-1, "          \
         "tight where the scene constrains it, loose where degenerate) instead of the fixed lidar_*_std")              \

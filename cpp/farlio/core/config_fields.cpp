@@ -216,6 +216,9 @@ void validate_config(const FusionConfig& fusion) {
           "fusion.imu_gap_limit_s (" + number_text(fusion.imu_gap_limit_s) +
               ") must not exceed fusion.max_bridged_gap_s (" + number_text(fusion.max_bridged_gap_s) +
               "): a gap the fusion holds its input across must be bridged");
+  require(fusion.init_window_s < fusion.history_s,
+          "fusion.init_window_s (" + number_text(fusion.init_window_s) + ") must be below fusion.history_s (" +
+              number_text(fusion.history_s) + "): the initialisation reads the IMU of its window from that history");
 }
 
 void validate_config(const Config& config) {

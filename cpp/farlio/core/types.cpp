@@ -29,7 +29,7 @@ namespace {
 
 /// Whether none of the n floats is NaN or Inf: branch-free over the exponent bits, which the
 /// compiler vectorises (std::isfinite per value is several times slower on a 100k-point scan).
-bool all_finite(const float* values, std::size_t n) {
+bool floats_finite(const float* values, std::size_t n) {
   constexpr std::uint32_t kExponent = 0x7f800000u;  // all exponent bits set: Inf or NaN
   std::uint32_t bad = 0;
   for (std::size_t i = 0; i < n; ++i) {
@@ -40,10 +40,14 @@ bool all_finite(const float* values, std::size_t n) {
 
 }  // namespace
 
-std::size_t Scan::remove_non_finite() {
+bool Scan::all_finite() const {
   static_assert(sizeof(Vec3f) == 3 * sizeof(float), "points are 3n contiguous floats");
-  if (points.empty()) return 0;
-  if (all_finite(points.data()->data(), 3 * points.size()) && all_finite(time_s.data(), time_s.size())) return 0;
+  return points.empty() ||
+         (floats_finite(points.data()->data(), 3 * points.size()) && floats_finite(time_s.data(), time_s.size()));
+}
+
+std::size_t Scan::remove_non_finite() {
+  if (all_finite()) return 0;
   const bool t = has_time(), in = !intensity.empty(), id = !sensor_id.empty();
   const auto finite = [&](std::size_t i) {
     const Vec3f& p = points[i];

@@ -33,6 +33,8 @@ struct Scan {
   [[nodiscard]] double duration_s() const { return ns_to_seconds(end_stamp_ns - start_stamp_ns); }
   /// Throws InputError naming `what` if array sizes disagree or the stamps are inverted.
   void validate(const std::string& what) const;
+  /// Whether every coordinate and time is finite.
+  [[nodiscard]] bool all_finite() const;
   /// Removes points with a non-finite coordinate or time; returns how many were removed.
   std::size_t remove_non_finite();
 };

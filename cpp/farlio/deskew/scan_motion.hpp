@@ -87,7 +87,8 @@ struct DeskewTable {
 /// extrapolated).
 FARLIO_HD inline Eigen::Vector3f deskew_point(const DeskewTable& table, const Eigen::Vector3f& p, float tau_s) {
   const float x = tau_s * table.inv_step;
-  const float clamped = x < 0.0f ? 0.0f : (x > DeskewTable::kSegments - 1 ? DeskewTable::kSegments - 1 : x);
+  // written so that a NaN tau takes the first segment rather than an index out of the table
+  const float clamped = x >= 0.0f ? (x > DeskewTable::kSegments - 1 ? DeskewTable::kSegments - 1 : x) : 0.0f;
   const int k = static_cast<int>(clamped);
   const float a = x - static_cast<float>(k), b = 1.0f - a;
   const float* p0 = table.poses[k];

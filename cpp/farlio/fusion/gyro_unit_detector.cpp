@@ -12,6 +12,14 @@ namespace {
 constexpr double kDegreesPerRadian = 180.0 / M_PI;
 /// Integrals kept for the comparison: the longest interval between two registered scans.
 constexpr double kKeptIntegral_s = 5.0;
+/// The regression decides once the slope's interval of this many standard errors lies above zero,
+/// on one side of the midpoint between the units and around that unit's value, after
+/// kMinRegressionIntervals intervals.
+constexpr double kRegressionSigmas = 6.0;
+constexpr int kMinRegressionIntervals = 20;
+/// Beyond their standard error, the slope may miss its unit's value by this much (the gyro's
+/// scale factor, the LiDAR's and the IMU's timing).
+constexpr double kSlopeTolerance = 0.2;
 
 std::string number(double v) {
   char buf[32];
@@ -73,11 +81,52 @@ bool GyroUnitDetector::turning(std::int64_t start_ns, std::int64_t end_ns) const
   return rotation && *rotation > min_rate_rad_s_ * ns_to_seconds(end - start);
 }
 
-void GyroUnitDetector::add_lidar_rotation(std::int64_t start_ns, std::int64_t end_ns, double lidar_angle_rad) {
+void GyroUnitDetector::regress(const Eigen::Vector3d& gyro, const Eigen::Vector3d& lidar, double dt_s) {
+  s_gg_ += gyro.squaredNorm();
+  s_gl_ += gyro.dot(lidar);
+  s_ll_ += lidar.squaredNorm();
+  s_tt_ += dt_s * dt_s;
+  s_gt_ += gyro * dt_s;
+  s_lt_ += lidar * dt_s;
+  ++regression_intervals_;
+  if (regression_intervals_ < kMinRegressionIntervals) return;
+  // eliminating the intercept c = (s_lt - k s_gt) / s_tt
+  const double excitation = s_gg_ - s_gt_.squaredNorm() / s_tt_;  // the gyro's variation beyond a constant rate
+  if (!(excitation > 0.0)) return;
+  const double k = (s_gl_ - s_gt_.dot(s_lt_) / s_tt_) / excitation;
+  const double residual = s_ll_ - s_lt_.squaredNorm() / s_tt_ - k * (s_gl_ - s_gt_.dot(s_lt_) / s_tt_);
+  const double dof = 3.0 * regression_intervals_ - 4.0;
+  const double k_std = std::sqrt(std::max(residual, 0.0) / dof / excitation);
+  // k's interval: above zero (the LiDAR follows the gyro: not noise), on one side of the midpoint
+  // between the units, and around that unit's value
+  const double low = k - kRegressionSigmas * k_std, high = k + kRegressionSigmas * k_std;
+  const double midpoint = 1.0 / std::sqrt(kDegreesPerRadian);
+  const auto around = [&](double value) {
+    return low <= value * (1.0 + kSlopeTolerance) && high >= value * (1.0 - kSlopeTolerance);
+  };
+  if (low > 0.0 && high < midpoint && around(1.0 / kDegreesPerRadian)) {
+    unit_ = GyroUnit::kDegreesPerSecond;
+  } else if (low > midpoint && around(1.0)) {
+    unit_ = GyroUnit::kRadPerSecond;
+  } else {
+    return;
+  }
+  slope_ = k;
+  slope_std_ = k_std;
+  integrals_.clear();
+}
+
+void GyroUnitDetector::add_lidar_rotation(std::int64_t start_ns, std::int64_t end_ns,
+                                          const Eigen::Vector3d& lidar_rotation) {
   if (decided() || end_ns <= start_ns) return;
-  const auto gyro = gyro_rotation(start_ns, end_ns);
-  if (!gyro || lidar_angle_rad < min_rate_rad_s_ * ns_to_seconds(end_ns - start_ns)) return;
-  gyro_sum_rad_ += *gyro;
+  const auto a = integral_at(start_ns), b = integral_at(end_ns);
+  if (!a || !b) return;
+  const double dt_s = ns_to_seconds(end_ns - start_ns);
+  regress(*b - *a, lidar_rotation, dt_s);
+  if (decided()) return;
+  const double gyro = (*b - *a).norm(), lidar_angle_rad = lidar_rotation.norm();
+  if (lidar_angle_rad < min_rate_rad_s_ * dt_s) return;
+  gyro_sum_rad_ += gyro;
   lidar_sum_rad_ += lidar_angle_rad;
   ++intervals_;
   if (lidar_sum_rad_ < min_rotation_rad_) return;
@@ -95,12 +144,16 @@ void GyroUnitDetector::add_lidar_rotation(std::int64_t start_ns, std::int64_t en
 double GyroUnitDetector::scale() const { return unit_ == GyroUnit::kDegreesPerSecond ? 1.0 / kDegreesPerRadian : 1.0; }
 
 std::string GyroUnitDetector::message() const {
-  const std::string seen = "over " + std::to_string(intervals_) + " scan intervals the gyro integrated " +
-                           number(gyro_sum_rad_) + " while the LiDAR turned " + number(lidar_sum_rad_) + " rad";
+  const std::string seen =
+      slope_ != 0.0 ? "over " + std::to_string(regression_intervals_) + " scan intervals the LiDAR turned " +
+                          number(slope_) + " +- " + number(slope_std_) + " times as far as the gyro integrated"
+                    : "over " + std::to_string(intervals_) + " scan intervals the gyro integrated " +
+                          number(gyro_sum_rad_) + " while the LiDAR turned " + number(lidar_sum_rad_) + " rad";
+  const double ratio = slope_ != 0.0 ? 1.0 / slope_ : gyro_sum_rad_ / lidar_sum_rad_;
   switch (unit_) {
     case GyroUnit::kDegreesPerSecond:
-      return "the gyro reports in deg/s (" + seen + ", " + number(gyro_sum_rad_ / lidar_sum_rad_) +
-             " times as much): scaling it by pi/180; the fusion starts again from the next LiDAR result";
+      return "the gyro reports in deg/s (" + seen + ": the gyro reads " + number(ratio) +
+             " times the rotation): scaling it by pi/180; the fusion starts again from the next LiDAR results";
     case GyroUnit::kStuck:
       if (!gyro_changed_) {
         return "the gyro is stuck: its reading " + number(last_->gyro_rad_s.x()) + ", " +

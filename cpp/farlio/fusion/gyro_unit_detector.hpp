@@ -1,12 +1,19 @@
 #pragma once
 // Detects a gyro that reports in deg/s instead of rad/s, or that is stuck, against the LiDAR: the
 // rotation the gyro integrates between two registered scans is compared with the rotation
-// between their poses. Only intervals in which the LiDAR turned faster than a minimum rate count
-// (so that a gyro bias at rest weighs nothing). Once the LiDAR's rotation over those intervals
-// reaches min_rotation_rad, the ratio gyro / LiDAR decides on a log scale, as the accelerometer's
-// unit (accel_unit_detector.hpp): near 1 rad/s, near 180/pi deg/s (the midpoint is
-// sqrt(180/pi) = 7.6); below 1/7.6 the gyro does not follow the LiDAR at all (stuck: its reading
-// never changes, or dead) and is not to be used.
+// between their poses, in two ways.
+//   Turns: only intervals in which the LiDAR turned faster than a minimum rate count (so that a
+//   gyro bias at rest weighs nothing). Once the LiDAR's rotation over those intervals reaches
+//   min_rotation_rad, the ratio gyro / LiDAR decides on a log scale, as the accelerometer's unit
+//   (accel_unit_detector.hpp): near 1 rad/s, near 180/pi deg/s (the midpoint is sqrt(180/pi) =
+//   7.6); below 1/7.6 the gyro does not follow the LiDAR at all (stuck: its reading never
+//   changes, or dead) and is not to be used.
+//   Small rotations: over every interval, the LiDAR's rotation vector is regressed on the gyro's,
+//   with a constant rate (the gyro's bias) as the intercept: r_lidar = k r_gyro + c dt. The
+//   lane keeping, the road's grade and the body's sway of a straight drive are enough for k to
+//   come out near 1 (rad/s) or near pi/180 (deg/s) well before the first turn; k is taken once its
+//   interval of several standard errors lies above zero (the LiDAR follows the gyro: the gyro's
+//   readings are not its noise alone) and around one unit's value.
 // The detector also tells whether a scan's gyro rotation is large enough that, while the unit is
 // undecided, the fusion's guess (which a deg/s gyro would ruin) should not be used for it.
 #include <Eigen/Core>
@@ -36,8 +43,9 @@ class GyroUnitDetector {
   /// The norm of the gyro's integral over [start_ns, end_ns] (rad in the gyro's own unit);
   /// nullopt when the samples kept do not cover the interval.
   [[nodiscard]] std::optional<double> gyro_rotation(std::int64_t start_ns, std::int64_t end_ns) const;
-  /// The LiDAR rotation between two scan ends; decides once enough rotation was compared.
-  void add_lidar_rotation(std::int64_t start_ns, std::int64_t end_ns, double lidar_angle_rad);
+  /// The LiDAR's rotation (rotation vector, body frame) between two scan ends; decides once
+  /// enough rotation was compared.
+  void add_lidar_rotation(std::int64_t start_ns, std::int64_t end_ns, const Eigen::Vector3d& lidar_rotation);
 
   [[nodiscard]] GyroUnit unit() const { return unit_; }
   [[nodiscard]] bool decided() const { return unit_ != GyroUnit::kUndecided; }
@@ -62,8 +70,16 @@ class GyroUnitDetector {
   std::deque<Integral> integrals_;
   std::optional<ImuSample> last_;
   bool gyro_changed_ = false;
+  /// The regression of the LiDAR's rotations on the gyro's: decides when k is clear.
+  void regress(const Eigen::Vector3d& gyro, const Eigen::Vector3d& lidar, double dt_s);
+
   double gyro_sum_rad_ = 0.0, lidar_sum_rad_ = 0.0;
   int intervals_ = 0;
+  // sums of the regression r_lidar = k r_gyro + c dt over the intervals
+  double s_gg_ = 0.0, s_gl_ = 0.0, s_ll_ = 0.0, s_tt_ = 0.0;
+  Eigen::Vector3d s_gt_ = Eigen::Vector3d::Zero(), s_lt_ = Eigen::Vector3d::Zero();
+  int regression_intervals_ = 0;
+  double slope_ = 0.0, slope_std_ = 0.0;  ///< k and its standard error when it decided
 };
 
 /// Mean |accel| below this (in m/s^2 or in g) is no accelerometer at all: it reads zero.

@@ -23,6 +23,7 @@ class ImuBuffer {
   bool push(const ImuSample& sample);
   [[nodiscard]] bool empty() const { return samples_.empty(); }
   [[nodiscard]] const ImuSample& newest() const { return samples_.back(); }
+  [[nodiscard]] const ImuSample& oldest() const { return samples_.front(); }
 
   /// The signal at stamp_ns (linear interpolation; held before the first and after the last sample).
   [[nodiscard]] ImuReading at(std::int64_t stamp_ns) const;

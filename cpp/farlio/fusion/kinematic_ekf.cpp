@@ -31,7 +31,7 @@ void KinematicEkf::predict(const InputVector& u_start, const InputVector& u_mid,
 
 double KinematicEkf::mahalanobis_squared(MeasurementKind kind, const Eigen::VectorXd& residual,
                                          const Eigen::MatrixXd& R) const {
-  const Eigen::MatrixXd H = measurement_jacobian(kind);
+  const Eigen::MatrixXd H = measurement_jacobian(kind, x_);
   const Eigen::MatrixXd S = H * P_ * H.transpose() + R;
   return residual.dot(S.ldlt().solve(residual));
 }
@@ -39,7 +39,7 @@ double KinematicEkf::mahalanobis_squared(MeasurementKind kind, const Eigen::Vect
 bool KinematicEkf::update(MeasurementKind kind, const Eigen::VectorXd& residual, const Eigen::MatrixXd& R,
                           double gate_chi2) {
   if (!residual.allFinite()) return false;
-  const Eigen::MatrixXd H = measurement_jacobian(kind);
+  const Eigen::MatrixXd H = measurement_jacobian(kind, x_);
   const Eigen::MatrixXd PHt = P_ * H.transpose();
   const Eigen::MatrixXd S = H * PHt + R;
   const auto S_ldlt = S.ldlt();

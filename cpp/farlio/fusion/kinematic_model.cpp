@@ -18,7 +18,16 @@ Eigen::Matrix3d rot_x(double a) { return Eigen::AngleAxisd(a, Eigen::Vector3d::U
 Eigen::Matrix3d rot_y(double a) { return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitY()).toRotationMatrix(); }
 Eigen::Matrix3d rot_z(double a) { return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()).toRotationMatrix(); }
 
+/// The tilt as a rotation vector (no turn about z).
+Eigen::Vector3d tilt_vector(const StateVector& x) { return {x(kTiltIndex), x(kTiltIndex + 1), 0.0}; }
+
 }  // namespace
+
+Eigen::Vector3d world_gravity(const StateVector& x, double gravity_m_s2) {
+  return so3_exp(tilt_vector(x)) * Eigen::Vector3d(0.0, 0.0, -gravity_m_s2);
+}
+
+Eigen::Matrix3d level_from_world(const StateVector& x) { return so3_exp(tilt_vector(x)).transpose(); }
 
 Eigen::Matrix3d euler_rate_matrix(const Eigen::Vector3d& rpy) {
   const double sr = std::sin(rpy.x()), cr = std::cos(rpy.x());
@@ -50,7 +59,7 @@ StateVector state_derivative(const StateVector& x, const InputVector& u_measured
   const Eigen::Vector3d a = u.segment<3>(kAccelIndex);
   const Eigen::Vector3d w = u.segment<3>(kGyroIndex);
   const Eigen::Matrix3d R = rotation_from_euler(rpy);
-  const Eigen::Vector3d g_world(0.0, 0.0, -gravity_m_s2);
+  const Eigen::Vector3d g_world = world_gravity(x, gravity_m_s2);
   StateVector dx = StateVector::Zero();
   dx.segment<3>(kPositionIndex) = R * v;
   dx.segment<3>(kAttitudeIndex) = euler_rate_matrix(rpy) * w;
@@ -65,12 +74,12 @@ ModelJacobians model_jacobians(const StateVector& x, const InputVector& u_measur
   const Eigen::Vector3d w = u.segment<3>(kGyroIndex);
   const double sr = std::sin(r), cr = std::cos(r), sp = std::sin(p);
   const double cp = clamped_cos_pitch(p), tp = sp / cp;
-  const double g = gravity_m_s2;
   // Derivatives of the elementary rotations: d/da Rx(a) = Rx(a) [e_x]x etc.
   const Eigen::Matrix3d Rx = rot_x(r), Ry = rot_y(p), Rz = rot_z(y);
   const Eigen::Matrix3d dRx = Rx * hat(Eigen::Vector3d::UnitX());
   const Eigen::Matrix3d dRy = Ry * hat(Eigen::Vector3d::UnitY());
   const Eigen::Matrix3d dRz = Rz * hat(Eigen::Vector3d::UnitZ());
+  const Eigen::Vector3d g = world_gravity(x, gravity_m_s2);
 
   ModelJacobians J;
   // p' = R v
@@ -84,9 +93,13 @@ ModelJacobians model_jacobians(const StateVector& x, const InputVector& u_measur
   J.df_dx.block<3, 1>(kAttitudeIndex, kAttitudeIndex + 0) = Eigen::Vector3d(tp * c, -s, c / cp);
   J.df_dx.block<3, 1>(kAttitudeIndex, kAttitudeIndex + 1) = Eigen::Vector3d(s / (cp * cp), 0.0, s * sp / (cp * cp));
   J.df_du.block<3, 3>(kAttitudeIndex, kGyroIndex) = euler_rate_matrix(x.segment<3>(kAttitudeIndex));
-  // v' = a - w x v + (g sp, -g sr cp, -g cr cp)
-  J.df_dx.block<3, 1>(kVelocityIndex, kAttitudeIndex + 0) = Eigen::Vector3d(0.0, -g * cr * cp, g * sr * cp);
-  J.df_dx.block<3, 1>(kVelocityIndex, kAttitudeIndex + 1) = Eigen::Vector3d(g * cp, g * sr * sp, g * cr * sp);
+  // v' = a - w x v + R^T g, R^T = Rx^T Ry^T Rz^T
+  J.df_dx.block<3, 1>(kVelocityIndex, kAttitudeIndex + 0) = dRx.transpose() * Ry.transpose() * Rz.transpose() * g;
+  J.df_dx.block<3, 1>(kVelocityIndex, kAttitudeIndex + 1) = Rx.transpose() * dRy.transpose() * Rz.transpose() * g;
+  J.df_dx.block<3, 1>(kVelocityIndex, kAttitudeIndex + 2) = Rx.transpose() * Ry.transpose() * dRz.transpose() * g;
+  // g = Exp(t) g0: dg/dt = -[g]x J_l(t), its x and y columns
+  const Eigen::Matrix3d dg_dt = -hat(g) * so3_left_jacobian(tilt_vector(x));
+  J.df_dx.block<3, 2>(kVelocityIndex, kTiltIndex) = (Rz * Ry * Rx).transpose() * dg_dt.leftCols<2>();
   J.df_dx.block<3, 3>(kVelocityIndex, kVelocityIndex) = -hat(w);
   J.df_du.block<3, 3>(kVelocityIndex, kAccelIndex) = Eigen::Matrix3d::Identity();
   J.df_du.block<3, 3>(kVelocityIndex, kGyroIndex) = hat(v);

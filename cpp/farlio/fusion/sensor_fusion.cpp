@@ -13,6 +13,18 @@
 namespace farlio::fusion {
 namespace {
 constexpr std::size_t kExtraHistoryEntries = 2;  ///< both ends of the history span
+/// In motion, the LiDAR results the alignment needs at least (two equations a pair, six unknowns
+/// a pose: three poses make it overdetermined).
+constexpr std::size_t kMinPosesInMotion = 3;
+/// The zero-velocity prior of a window that shows the body at rest (m/s): tight, so that gravity
+/// follows from the specific force as in levelling.
+constexpr double kRestVelocityStd_m_s = 0.01;
+/// The std of the world frame's tilt after an initialisation in motion (rad): the alignment's
+/// error over init_window_s, which the tilt state then refines.
+constexpr double kInMotionTiltStd_rad = 0.05;
+/// A window whose free gravity estimate is further than this (relative) from the known
+/// magnitude does not initialise the filter: its poses or IMU disagree (a failing registration).
+constexpr double kMaxGravityNormError = 0.1;
 
 double square(double v) { return v * v; }
 
@@ -44,7 +56,7 @@ struct LidarGroup {
 };
 }  // namespace
 
-SensorFusion::SensorFusion(const FusionConfig& config, double gravity_m_s2)
+SensorFusion::SensorFusion(const FusionConfig& config, double gravity_m_s2, MapFrameKnowledge known)
     : config_(validated(config)),
       gravity_m_s2_(gravity_m_s2),
       step_ns_(seconds_to_ns(config.step_s)),
@@ -56,7 +68,26 @@ SensorFusion::SensorFusion(const FusionConfig& config, double gravity_m_s2)
       reference_(config.reference_filter_taps, gravity_m_s2, config.reference_max_sin),
       history_(static_cast<std::size_t>(std::ceil(config.history_s / config.step_s)) + kExtraHistoryEntries),
       queue_(config.delay_compensation),
-      accel_bias_m_s2_(config.accel_bias_x_m_s2, config.accel_bias_y_m_s2, config.accel_bias_z_m_s2) {}
+      accel_bias_m_s2_(config.accel_bias_x_m_s2, config.accel_bias_y_m_s2, config.accel_bias_z_m_s2),
+      window_(std::move(known.window)),
+      known_tilt_std_rad_(known.tilt_std_rad) {
+  if (known.gravity_map_m_s2) level_from_map_ = level_from_map(*known.gravity_map_m_s2);
+}
+
+MapFrameKnowledge SensorFusion::map_frame_knowledge() const {
+  MapFrameKnowledge k;
+  k.window = window_;
+  if (!level_from_map_) return k;
+  const Eigen::Matrix3d map_from_level = level_from_map_->transpose();
+  if (!initialized()) {
+    k.gravity_map_m_s2 = map_from_level * Eigen::Vector3d(0.0, 0.0, -gravity_m_s2_);
+    k.tilt_std_rad = known_tilt_std_rad_;
+    return k;
+  }
+  k.gravity_map_m_s2 = map_from_level * world_gravity(ekf_.state(), gravity_m_s2_);
+  k.tilt_std_rad = std::sqrt(ekf_.covariance().block<2, 2>(kTiltIndex, kTiltIndex).diagonal().maxCoeff());
+  return k;
+}
 
 void SensorFusion::warn(std::string message) { stats_.last_warning = std::move(message); }
 
@@ -158,28 +189,28 @@ void SensorFusion::fuse_reference_angles(std::int64_t stamp_ns) {
   }
 }
 
-void SensorFusion::initialize(std::int64_t stamp_ns, const SE3& pose, const Eigen::Vector3d& velocity,
-                              bool velocity_known) {
+void SensorFusion::initialize(std::int64_t stamp_ns, const SE3& level_pose, const Eigen::Vector3d& velocity_body_m_s,
+                              double velocity_std_m_s, double tilt_std_rad) {
   accel_unit_.decide();
   // a re-initialisation keeps the bias estimates and their uncertainty
   const bool keep_biases = ekf_.initialized();
   const StateVector previous = ekf_.state();
   const StateMatrix previous_P = ekf_.covariance();
   StateVector x = StateVector::Zero();
-  x.segment<3>(kPositionIndex) = pose.translation();
-  x.segment<3>(kAttitudeIndex) = euler_from_rotation(pose.rotation());
-  if (velocity_known) x.segment<3>(kVelocityIndex) = velocity;
+  x.segment<3>(kPositionIndex) = level_pose.translation();
+  x.segment<3>(kAttitudeIndex) = euler_from_rotation(level_pose.rotation());
+  x.segment<3>(kVelocityIndex) = velocity_body_m_s;
   StateVector variance = StateVector::Zero();
   variance.segment<3>(kPositionIndex).setConstant(square(config_.initial_position_std_m));
   variance.segment<3>(kAttitudeIndex).setConstant(square(config_.initial_attitude_std_rad));
-  variance.segment<3>(kVelocityIndex)
-      .setConstant(square(velocity_known ? config_.lidar_velocity_std_m_s : config_.initial_velocity_std_m_s));
+  variance.segment<3>(kVelocityIndex).setConstant(square(velocity_std_m_s));
   if (config_.estimate_imu_bias) {
     variance.segment<3>(kGyroBiasIndex).setConstant(square(config_.gyro_bias_std_rad_s));
     variance.segment<3>(kAccelBiasIndex).setConstant(square(config_.accel_bias_std_m_s2));
   }
+  variance.segment<2>(kTiltIndex).setConstant(square(tilt_std_rad));
   StateMatrix P = variance.asDiagonal();
-  if (keep_biases) {
+  if (keep_biases) {  // and the tilt
     constexpr int kBiasStates = kStateDim - kGyroBiasIndex;
     x.tail<kBiasStates>() = previous.tail<kBiasStates>();
     P.bottomRightCorner<kBiasStates, kBiasStates>() = previous_P.bottomRightCorner<kBiasStates, kBiasStates>();
@@ -196,6 +227,111 @@ void SensorFusion::initialize(std::int64_t stamp_ns, const SE3& pose, const Eige
   while (clock_set_ && time_ns_ + step_ns_ <= clock_ns_) step();
 }
 
+void SensorFusion::initialize_known(std::int64_t stamp_ns, const SE3& body_pose,
+                                    const Eigen::Vector3d& velocity_body_m_s) {
+  level_from_map_ = Eigen::Matrix3d::Identity();
+  initialize(stamp_ns, body_pose, velocity_body_m_s, config_.lidar_velocity_std_m_s, 0.0);
+  last_lidar_ns_ = stamp_ns;
+  add_to_window(stamp_ns, body_pose);
+  InitializationReport& report = stats_.initialization;
+  report = InitializationReport{};
+  report.initialized = true;
+  report.mode = "given";
+  report.stamp_ns = stamp_ns;
+  report.speed_m_s = velocity_body_m_s.norm();
+}
+
+SE3 SensorFusion::to_level(const SE3& map_pose) const {
+  if (!level_from_map_) return map_pose;
+  return {*level_from_map_ * map_pose.rotation(), *level_from_map_ * map_pose.translation()};
+}
+
+SE3 SensorFusion::to_map(const SE3& level_pose) const {
+  if (!level_from_map_) return level_pose;
+  const Eigen::Matrix3d map_from_level = level_from_map_->transpose();
+  return {map_from_level * level_pose.rotation(), map_from_level * level_pose.translation()};
+}
+
+void SensorFusion::add_to_window(std::int64_t stamp_ns, const SE3& body_pose) {
+  if (!window_.empty() && stamp_ns <= window_.back().stamp_ns) return;
+  const auto span_s = [&](const WindowPose& from) { return ns_to_seconds(stamp_ns - from.stamp_ns); };
+  if (!window_.empty() && span_s(window_.back()) > config_.init_window_s) window_.clear();  // an outage
+  window_.push_back({stamp_ns, body_pose});
+  // the shortest run of the newest results that spans init_window_s
+  while (window_.size() > 2 && span_s(window_[1]) >= config_.init_window_s) window_.erase(window_.begin());
+}
+
+std::optional<ImuMean> SensorFusion::imu_mean(std::int64_t start_ns, std::int64_t end_ns) const {
+  // before the oldest sample kept the signal is unknown; beyond the newest it is held up to the
+  // gap limit (ImuBuffer flags it as a gap after that)
+  if (imu_.empty() || start_ns < imu_.oldest().stamp_ns) return std::nullopt;
+  const ImuReading r = imu_.mean(start_ns, end_ns);
+  if (r.in_gap) return std::nullopt;
+  const InputVector u = initialized() ? corrected_input(ekf_.state(), input_of(r)) : input_of(r);
+  return ImuMean{u.segment<3>(kAccelIndex), u.segment<3>(kGyroIndex)};
+}
+
+std::optional<Eigen::Matrix3d> SensorFusion::imu_rotation(std::int64_t start_ns, std::int64_t end_ns) const {
+  const auto increment =
+      integrate_imu([this](std::int64_t t0, std::int64_t t1) { return imu_mean(t0, t1); }, start_ns, end_ns, step_ns_);
+  if (!increment) return std::nullopt;
+  return increment->rotation;
+}
+
+bool SensorFusion::window_at_rest() const {
+  for (std::size_t k = 1; k < window_.size(); ++k) {
+    const double dt_s = ns_to_seconds(window_[k].stamp_ns - window_[k - 1].stamp_ns);
+    const SE3 motion = window_[k - 1].body_pose.inverse() * window_[k].body_pose;
+    if (motion.translation().norm() > config_.standstill_max_speed_m_s * dt_s ||
+        motion.angle_rad() > config_.standstill_max_gyro_rad_s * dt_s)
+      return false;
+  }
+  return window_.size() >= 2;
+}
+
+bool SensorFusion::initialize_from_window() {
+  if (window_.size() < 2) return false;
+  accel_unit_.decide();  // the alignment reads the accelerometer in m/s^2
+  AlignmentOptions options;
+  options.gravity_m_s2 = gravity_m_s2_;
+  options.step_ns = step_ns_;
+  if (level_from_map_) options.gravity_map_m_s2 = level_from_map_->transpose() * Eigen::Vector3d(0, 0, -gravity_m_s2_);
+  const bool at_rest = window_at_rest();
+  const double span_s = ns_to_seconds(window_.back().stamp_ns - window_.front().stamp_ns);
+  if (at_rest) {  // gravity is the mean specific force, the velocity zero: two results suffice
+    options.zero_velocity_std_m_s = kRestVelocityStd_m_s;
+  } else if (!level_from_map_ && (window_.size() < kMinPosesInMotion || span_s < config_.init_window_s)) {
+    return false;  // in motion, gravity is found over the whole window
+  }
+  const auto alignment = align_window(
+      window_, [this](std::int64_t t0, std::int64_t t1) { return imu_mean(t0, t1); }, options);
+  if (!alignment) return false;
+  const bool first = !level_from_map_;
+  if (first) {
+    if (alignment->gravity_norm_error > kMaxGravityNormError) return false;  // the window disagrees: wait
+    level_from_map_ = level_from_map(alignment->gravity_map_m_s2);
+  }
+  const WindowPose& last = window_.back();
+  const Eigen::Vector3d velocity_body = last.body_pose.rotation().transpose() * alignment->velocity_map_m_s;
+  // levelled at rest, gravity is off by the accelerometer's bias; in motion, by the alignment's error
+  const double levelled_tilt_std_rad = config_.accel_bias_std_m_s2 / gravity_m_s2_;
+  const double tilt_std_rad = first ? (at_rest ? levelled_tilt_std_rad : kInMotionTiltStd_rad) : known_tilt_std_rad_;
+  initialize(last.stamp_ns, to_level(last.body_pose), velocity_body, config_.lidar_velocity_std_m_s, tilt_std_rad);
+  InitializationReport& report = stats_.initialization;
+  if (!report.initialized) {
+    report.initialized = true;
+    report.mode = at_rest ? "standstill" : "in motion";
+    report.stamp_ns = last.stamp_ns;
+    report.window_poses = static_cast<int>(window_.size());
+    report.window_s = span_s;
+    report.speed_m_s = alignment->velocity_map_m_s.norm();
+    report.gravity_norm_error = alignment->gravity_norm_error;
+    report.up_map = level_from_map_->transpose() * Eigen::Vector3d::UnitZ();
+    report.map_tilt_deg = std::acos(std::clamp(report.up_map.z(), -1.0, 1.0)) * 180.0 / M_PI;
+  }
+  return true;
+}
+
 int SensorFusion::spread_steps(std::int64_t measured_at_ns) const {
   if (config_.update_spread_steps > 0) return config_.update_spread_steps;
   if (!last_lidar_ns_ || measured_at_ns <= *last_lidar_ns_) return 1;
@@ -203,17 +339,18 @@ int SensorFusion::spread_steps(std::int64_t measured_at_ns) const {
   return static_cast<int>(std::clamp<long long>(n, 1, std::max(1, config_.max_update_spread_steps)));
 }
 
-LidarUpdateResult SensorFusion::add_lidar(std::int64_t measured_at_ns, const SE3& body_pose,
+LidarUpdateResult SensorFusion::add_lidar(std::int64_t measured_at_ns, const SE3& map_pose,
                                           const Eigen::Vector3d& body_velocity_m_s, bool use_velocity,
                                           const std::optional<Mat6d>& body_covariance,
                                           const std::optional<Eigen::Matrix3d>& velocity_covariance) {
   LidarUpdateResult result;
+  add_to_window(measured_at_ns, map_pose);
   if (!initialized()) {
-    initialize(measured_at_ns, body_pose, body_velocity_m_s, use_velocity);
+    result.initialized_filter = initialize_from_window();
     last_lidar_ns_ = measured_at_ns;
-    result.initialized_filter = true;
     return result;
   }
+  const SE3 body_pose = to_level(map_pose);
   std::vector<LidarGroup> groups;
   const Eigen::Vector3d angles = euler_from_rotation(body_pose.rotation());
   const bool registration_covariance = body_covariance && config_.lidar_information_from_registration;
@@ -269,8 +406,12 @@ LidarUpdateResult SensorFusion::add_lidar(std::int64_t measured_at_ns, const SE3
   if (consecutive_rejections_ >= std::max(1, config_.max_consecutive_rejections)) {
     ++stats_.reinitializations;
     warn("LiDAR positions rejected " + std::to_string(consecutive_rejections_) +
-         " times in a row: re-initialising from the LiDAR result");
-    initialize(measured_at_ns, body_pose, body_velocity_m_s, use_velocity);
+         " times in a row: re-initialising from the LiDAR results of the last fusion.init_window_s");
+    if (!initialize_from_window()) {  // the window too short (an outage): the eq. (6) velocity
+      const Eigen::Vector3d velocity =
+          use_velocity ? body_velocity_m_s : Eigen::Vector3d(ekf_.state().segment<3>(kVelocityIndex));
+      initialize(measured_at_ns, body_pose, velocity, config_.lidar_velocity_std_m_s, 0.0);
+    }
     result.initialized_filter = true;
   }
   return result;
@@ -282,7 +423,7 @@ BodyEstimate SensorFusion::estimate() const {
   const StateVector& x = ekf_.state();
   e.valid = true;
   e.stamp_ns = time_ns_;
-  e.pose = pose_of(x);
+  e.pose = to_map(pose_of(x));
   e.velocity_body_m_s = x.segment<3>(kVelocityIndex);
   return e;
 }
@@ -291,12 +432,13 @@ std::optional<SE3> SensorFusion::pose_at(std::int64_t stamp_ns) const {
   if (!initialized() || history_.empty()) return std::nullopt;
   // the corrections applied since that step move the past as they moved the present (the x_s of
   // delay compensation, eq. 10): a scan that starts after a later result was fused gets it too
-  if (const auto entry = history_.entry_at(stamp_ns)) return pose_of(corrected_since(*entry, cumulative_correction_));
+  if (const auto entry = history_.entry_at(stamp_ns))
+    return to_map(pose_of(corrected_since(*entry, cumulative_correction_)));
   const StampedState& newest = history_.newest();
   const double ahead_s = ns_to_seconds(stamp_ns - newest.stamp_ns);
   if (ahead_s <= 0.0 || ahead_s > config_.max_extrapolation_s) return std::nullopt;
   const StateVector x = corrected_since(newest, cumulative_correction_);
-  return pose_of(integrate_step(x, last_input_, last_input_, last_input_, ahead_s, gravity_m_s2_));
+  return to_map(pose_of(integrate_step(x, last_input_, last_input_, last_input_, ahead_s, gravity_m_s2_)));
 }
 
 FusionStats SensorFusion::stats() const {
@@ -310,6 +452,11 @@ FusionStats SensorFusion::stats() const {
     s.accel_bias_m_s2 += ekf_.state().segment<3>(kAccelBiasIndex);
   }
   s.bias_samples = static_cast<std::int64_t>(bias_.sample_count());
+  if (initialized()) {
+    const Eigen::Matrix3d map_from_world =
+        level_from_map_ ? Eigen::Matrix3d(level_from_map_->transpose()) : Eigen::Matrix3d::Identity();
+    s.up_map = map_from_world * level_from_world(ekf_.state()).transpose() * Eigen::Vector3d::UnitZ();
+  }
   return s;
 }
 

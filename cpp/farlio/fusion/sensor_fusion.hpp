@@ -2,10 +2,19 @@
 // The sensor-fusion front (paper Sec. "Sensor Fusion"): IMU samples in, LiDAR results in, the
 // fused body odometry out. Deterministic and clock-free: time only advances through
 // advance_to(), on a fixed grid of FusionConfig::step_s anchored at the initialisation stamp.
+//
+// Poses in and out are in the map frame of the scan pipeline, which need not be level (it is
+// fixed at the first scan, while the body may already move). The filter is initialised from the
+// LiDAR results of its first scans and the IMU between them (initialization.hpp): at rest as soon
+// as two results show it, in motion once they span fusion.init_window_s; that alignment finds
+// gravity in the map frame, and the EKF runs in the level frame it gives (z up), so that its
+// gravity and reference angles hold. A re-initialisation after rejected results takes the
+// velocity from the LiDAR results of the same window, with gravity already known.
 #include <Eigen/Core>
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "farlio/core/config.hpp"
 #include "farlio/core/se3.hpp"
@@ -14,6 +23,7 @@
 #include "farlio/fusion/delay_compensation.hpp"
 #include "farlio/fusion/imu_buffer.hpp"
 #include "farlio/fusion/imu_gate.hpp"
+#include "farlio/fusion/initialization.hpp"
 #include "farlio/fusion/kinematic_ekf.hpp"
 #include "farlio/fusion/reference_angles.hpp"
 #include "farlio/fusion/standstill_bias.hpp"
@@ -34,6 +44,9 @@ struct FusionStats {
   std::int64_t lidar_groups_rejected = 0;  ///< by the Mahalanobis gate
   std::int64_t lidar_too_old = 0;          ///< older than the state history: rejected
   std::int64_t reinitializations = 0;      ///< after max_consecutive_rejections
+  InitializationReport initialization;     ///< how and when the filter was first initialised
+  /// The up direction (against gravity) in the map frame as the filter now estimates it.
+  Eigen::Vector3d up_map = Eigen::Vector3d::UnitZ();
   std::int64_t reference_angles_accepted = 0;
   std::int64_t reference_angles_rejected = 0;                 ///< gated or saturated
   std::int64_t imu_gaps = 0;                                  ///< gap events (each held-input stretch counts once)
@@ -58,7 +71,9 @@ struct LidarUpdateResult {
 
 class SensorFusion {
  public:
-  SensorFusion(const FusionConfig& config, double gravity_m_s2);
+  /// `known`: what an earlier filter of the same run found of the map frame (its gravity, its
+  /// window): the new one then needs no new alignment of gravity.
+  SensorFusion(const FusionConfig& config, double gravity_m_s2, MapFrameKnowledge known = {});
 
   /// Any rate; a sample older than the newest one is dropped and counted.
   void add_imu(const ImuSample& sample);
@@ -66,32 +81,63 @@ class SensorFusion {
   /// clock moves.
   void advance_to(std::int64_t stamp_ns);
   /// A LiDAR result for the scan-end stamp measured_at_ns, delivered at the current filter time
-  /// (the difference is its delay). The first one initialises the filter.
-  /// body_covariance: the registration's covariance of a right perturbation [t; r] of body_pose
+  /// (the difference is its delay); map_pose: the body pose in the map frame. Before the filter is initialised
+  /// the results gather in the initialisation window until they initialise it.
+  /// body_covariance: the registration's covariance of a right perturbation [t; r] of map_pose
   /// (registration/degeneracy.hpp); fused as one pose group when given and
   /// lidar_information_from_registration, else the fixed lidar_*_std apply. velocity_covariance:
   /// of the body velocity (lidar_measurement.hpp), used under the same condition; else
   /// lidar_velocity_std_m_s.
-  LidarUpdateResult add_lidar(std::int64_t measured_at_ns, const SE3& body_pose,
+  LidarUpdateResult add_lidar(std::int64_t measured_at_ns, const SE3& map_pose,
                               const Eigen::Vector3d& body_velocity_m_s, bool use_velocity,
                               const std::optional<Mat6d>& body_covariance = std::nullopt,
                               const std::optional<Eigen::Matrix3d>& velocity_covariance = std::nullopt);
 
+  /// Starts the filter from a known state instead (another navigation system, a test): the body
+  /// pose in a level map frame at stamp_ns and its velocity; the next LiDAR results update it.
+  void initialize_known(std::int64_t stamp_ns, const SE3& body_pose, const Eigen::Vector3d& velocity_body_m_s);
+
+  /// The map started again (after failures, or from the first scan at speed): the LiDAR results so
+  /// far are not comparable with the next ones; the initialisation window starts again.
+  void restart_window() { window_.clear(); }
+
   [[nodiscard]] bool initialized() const { return ekf_.initialized(); }
+  /// Gravity in the map frame as now estimated, and the window, for a filter that takes over.
+  [[nodiscard]] MapFrameKnowledge map_frame_knowledge() const;
   [[nodiscard]] const FusionConfig& config() const { return config_; }
   /// The filter step (FusionConfig::step_s) in ns.
   [[nodiscard]] std::int64_t step_ns() const { return step_ns_; }
+  /// The current estimate, its pose in the map frame.
   [[nodiscard]] BodyEstimate estimate() const;
   /// The pose at stamp_ns as the filter now estimates it: the history's state plus the corrections
   /// applied since (as delay compensation shifts a past state), or predicted with the last input
   /// up to max_extrapolation_s beyond the newest step; nullopt otherwise.
   [[nodiscard]] std::optional<SE3> pose_at(std::int64_t stamp_ns) const;
+  /// The body's rotation from start_ns to end_ns as the gyro integrates it (biases removed);
+  /// nullopt where the IMU kept does not cover the interval or has a gap there.
+  [[nodiscard]] std::optional<Eigen::Matrix3d> imu_rotation(std::int64_t start_ns, std::int64_t end_ns) const;
   /// The bias-corrected angular rate used in the last step (rad/s, body frame).
   [[nodiscard]] Eigen::Vector3d angular_velocity_body() const { return corrected_last_input().segment<3>(kGyroIndex); }
   [[nodiscard]] FusionStats stats() const;
 
  private:
-  void initialize(std::int64_t stamp_ns, const SE3& pose, const Eigen::Vector3d& velocity, bool velocity_known);
+  /// Adds a LiDAR result to the initialisation window (the last init_window_s of results; a gap
+  /// longer than that starts it again).
+  void add_to_window(std::int64_t stamp_ns, const SE3& body_pose);
+  /// Initialises the filter from the window when its results allow (initialization.hpp); true if it did.
+  bool initialize_from_window();
+  /// Whether the window's results show the body at rest (standstill_max_speed_m_s and
+  /// standstill_max_gyro_rad_s between every two).
+  [[nodiscard]] bool window_at_rest() const;
+  /// The mean IMU input over [start_ns, end_ns] with the biases removed, for the alignment.
+  [[nodiscard]] std::optional<ImuMean> imu_mean(std::int64_t start_ns, std::int64_t end_ns) const;
+  /// A map-frame pose in the filter's level frame, and back.
+  [[nodiscard]] SE3 to_level(const SE3& map_pose) const;
+  [[nodiscard]] SE3 to_map(const SE3& level_pose) const;
+  /// Starts the filter at a pose in its world frame; the tilt's std 0 holds it at zero. A
+  /// re-initialisation keeps the biases and the tilt with their covariance.
+  void initialize(std::int64_t stamp_ns, const SE3& level_pose, const Eigen::Vector3d& velocity_body_m_s,
+                  double velocity_std_m_s, double tilt_std_rad);
   void step();
   [[nodiscard]] InputVector input_of(const ImuReading& r) const;
   /// The last input with the filter's bias estimates removed.
@@ -122,6 +168,9 @@ class SensorFusion {
   std::optional<std::int64_t> last_lidar_ns_;
   int consecutive_rejections_ = 0;
   InputVector last_input_ = InputVector::Zero();
+  std::vector<WindowPose> window_;                 ///< the initialisation window (map frame)
+  std::optional<Eigen::Matrix3d> level_from_map_;  ///< set by the first initialisation
+  double known_tilt_std_rad_ = 0.0;                ///< with level_from_map_ given at construction
   StateVector cumulative_correction_ = StateVector::Zero();
   FusionStats stats_;
 };

@@ -15,6 +15,8 @@ namespace {
 
 // Poses sampled over a scan for the motion regression.
 constexpr int kMotionSamples = 11;
+/// A gyro whose unit is not decided after this much time comparing it with the LiDAR gets a warning.
+constexpr double kUndecidedGyroWarning_s = 10.0;
 /// Warnings kept between two take_warnings calls; later ones are left out (a last one says so).
 constexpr std::size_t kMaxPendingWarnings = 100;
 
@@ -37,17 +39,24 @@ bool in_gravity_window(const ImuSample& first, const ImuSample& s) {
 
 }  // namespace
 
-SE3 gravity_aligned_start(const std::vector<ImuSample>& imu, std::int64_t until_ns) {
+SE3 gravity_aligned_start(const std::vector<ImuSample>& imu, std::int64_t until_ns, double gravity_m_s2,
+                          double max_gyro_rad_s) {
   if (imu.empty() || imu.front().stamp_ns > until_ns) return SE3();
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero(), mean_gyro = Eigen::Vector3d::Zero();
   int n = 0;
   for (const auto& s : imu) {
     if (s.stamp_ns > until_ns || !in_gravity_window(imu.front(), s)) break;
     mean += s.accel_m_s2;
+    mean_gyro += s.gyro_rad_s;
     ++n;
   }
   mean /= n;
+  mean_gyro /= n;
   if (mean.norm() <= 0.0 || !mean.allFinite()) return SE3();
+  // accelerating or turning, the specific force is not gravity: the body's own attitude is as good
+  // a guess (a car's roll and pitch are small), and the filter finds gravity in motion
+  if (std::abs(mean.norm() - gravity_m_s2) > kLevelledStartMaxAccelDeviation_m_s2 || mean_gyro.norm() > max_gyro_rad_s)
+    return SE3();
   const double roll = std::atan2(mean.y(), mean.z());
   const double pitch = std::atan2(-mean.x(), std::hypot(mean.y(), mean.z()));
   const Eigen::Quaterniond q =
@@ -102,7 +111,11 @@ ImuSample FusionDriver::in_si_units(const ImuSample& sample) const {
 }
 
 void FusionDriver::restart_fusion(const std::deque<ImuSample>& samples, bool regrid) {
-  fusion_.emplace(fusion_config_, gravity_m_s2_);
+  // the map frame is the same: its gravity carries over; the window too, unless the IMU clock
+  // jumped (its results lie on the old clock)
+  fusion::MapFrameKnowledge known = fusion_ ? fusion_->map_frame_knowledge() : fusion::MapFrameKnowledge{};
+  if (regrid) known.window.clear();
+  fusion_.emplace(fusion_config_, gravity_m_s2_, std::move(known));
   if (regrid) {
     next_output_ns_ = 0;
     last_output_ns_.reset();
@@ -111,23 +124,15 @@ void FusionDriver::restart_fusion(const std::deque<ImuSample>& samples, bool reg
   if (!samples.empty()) fusion_->advance_to(samples.back().stamp_ns);
 }
 
+double FusionDriver::jump_s(const ImuSample& sample) const {
+  // in seconds: the difference of two arbitrary int64 stamps may not fit an int64
+  return newest_imu_ns_ ? ns_to_seconds(sample.stamp_ns) - ns_to_seconds(*newest_imu_ns_) : 0.0;
+}
+
 bool FusionDriver::admit(const ImuSample& sample) {
-  if (newest_imu_ns_) {
-    // in seconds: the difference of two arbitrary int64 stamps may not fit an int64
-    const double jump_s = ns_to_seconds(sample.stamp_ns) - ns_to_seconds(*newest_imu_ns_);
-    if (std::abs(jump_s) > fusion_config_.max_bridged_gap_s) {
-      warn("IMU stamp " + seconds_text(ns_to_seconds(sample.stamp_ns)) + " s jumps by " + seconds_text(jump_s) +
-           " s from the newest (" + seconds_text(ns_to_seconds(*newest_imu_ns_)) +
-           " s), beyond fusion.max_bridged_gap_s (" + seconds_text(fusion_config_.max_bridged_gap_s) +
-           " s): the fusion is reset and starts again from the next LiDAR result");
-      recent_imu_.clear();
-      gyro_unit_.forget_samples();
-      restart_fusion(recent_imu_, /*regrid=*/true);
-      clock_ns_ = sample.stamp_ns;
-    } else if (sample.stamp_ns < *newest_imu_ns_) {
-      fusion_->add_imu(sample);  // older than the newest: the fusion drops and counts it
-      return false;
-    }
+  if (sample.stamp_ns < newest_imu_ns_.value_or(sample.stamp_ns)) {
+    fusion_->add_imu(sample);  // older than the newest: the fusion drops and counts it
+    return false;
   }
   newest_imu_ns_ = sample.stamp_ns;
   if (first_accels_.size() < static_cast<std::size_t>(fusion_config_.accel_unit_detection_samples)) {
@@ -143,7 +148,43 @@ bool FusionDriver::admit(const ImuSample& sample) {
   return true;
 }
 
+void FusionDriver::jump_clock(const ImuSample& sample) {
+  warn("IMU stamp " + seconds_text(ns_to_seconds(sample.stamp_ns)) + " s jumps by " + seconds_text(jump_s(sample)) +
+       " s from the newest (" + seconds_text(ns_to_seconds(*newest_imu_ns_)) +
+       " s), beyond fusion.max_bridged_gap_s (" + seconds_text(fusion_config_.max_bridged_gap_s) +
+       " s), and the samples after it follow it: the fusion is reset and starts again from the next LiDAR results");
+  recent_imu_.clear();
+  gyro_unit_.forget_samples();
+  restart_fusion(recent_imu_, /*regrid=*/true);
+  clock_ns_ = sample.stamp_ns;
+  newest_imu_ns_.reset();
+}
+
 void FusionDriver::add_imu(const ImuSample& sample, Samples& out) {
+  if (!fusion_) return;
+  // A sample beyond fusion.max_bridged_gap_s from the newest waits for the next one: when that
+  // follows it, the clock jumped (the fusion starts again there); when it follows the newest, the
+  // held sample alone was stamped wrong and is dropped (one bad stamp costs one sample).
+  if (held_jump_) {
+    const ImuSample held = *std::exchange(held_jump_, std::nullopt);
+    const double from_held_s = ns_to_seconds(sample.stamp_ns) - ns_to_seconds(held.stamp_ns);
+    if (from_held_s >= 0.0 && from_held_s <= fusion_config_.max_bridged_gap_s) {
+      jump_clock(held);
+      feed_imu(held, out);
+    } else {
+      warn("IMU sample stamped " + seconds_text(ns_to_seconds(held.stamp_ns)) + " s jumps by " +
+           seconds_text(jump_s(held)) + " s from the samples around it: dropped");
+    }
+  }
+  if (!fusion_) return;
+  if (std::abs(jump_s(sample)) > fusion_config_.max_bridged_gap_s) {
+    held_jump_ = sample;
+    return;
+  }
+  feed_imu(sample, out);
+}
+
+void FusionDriver::feed_imu(const ImuSample& sample, Samples& out) {
   if (!fusion_ || !admit(sample)) return;
   if (!gyro_unit_.decided()) {
     gyro_unit_.add_imu(sample);
@@ -191,28 +232,52 @@ void FusionDriver::apply_gyro_unit() {
 
 SE3 FusionDriver::start_pose(std::int64_t first_scan_end_ns, const std::optional<SE3>& requested) const {
   if (!fusion_) return requested.value_or(SE3());
-  const SE3 level = gravity_aligned_start(startup_imu_, first_scan_end_ns);
+  const SE3 level =
+      gravity_aligned_start(startup_imu_, first_scan_end_ns, gravity_m_s2_, fusion_config_.standstill_max_gyro_rad_s);
   if (!requested) return level;
   Eigen::Vector3d rpy = fusion::euler_from_rotation(level.rotation());
   rpy.z() = fusion::euler_from_rotation(requested->rotation()).z();
   return SE3(fusion::rotation_from_euler(rpy), requested->translation());
 }
 
-ScanPrior FusionDriver::prior(const Scan& scan) const {
+ScanPrior FusionDriver::prior(const Scan& scan, const registration::Vec6d& lidar_twist) const {
   ScanPrior prior;
-  if (!fusion_ || !fusion_->initialized()) return prior;
+  if (!fusion_) return prior;
   // while the gyro's unit is undecided, a scan during which it turns is registered by the LiDAR
   // alone: a deg/s gyro would turn the guess 57 times too far (and the registration would follow)
   if (gyro_unit_.turning(scan.start_stamp_ns, scan.end_stamp_ns)) return prior;
-  if (const auto body = fusion_->pose_at(scan.end_stamp_ns)) {
-    prior.guess = *body * T_imu_lidar_;
-    prior.motion = motion_from_fusion(*fusion_, scan, *prior.guess, T_imu_lidar_);
+  if (fusion_->initialized()) {
+    if (const auto body = fusion_->pose_at(scan.end_stamp_ns)) {
+      prior.guess = *body * T_imu_lidar_;
+      prior.motion = motion_from_fusion(*fusion_, scan, *prior.guess, T_imu_lidar_);
+      prior.fused = true;
+    }
+    return prior;
+  }
+  // before the filter: the constant-velocity translation, turned as the gyro turned
+  if (!gyro_unit_.decided() || !last_body_ || scan.end_stamp_ns <= last_body_->stamp_ns) return prior;
+  const auto since_last = fusion_->imu_rotation(last_body_->stamp_ns, scan.end_stamp_ns);
+  const auto during_scan = fusion_->imu_rotation(scan.start_stamp_ns, scan.end_stamp_ns);
+  if (!since_last || !during_scan) return prior;
+  const Mat3d R_il = T_imu_lidar_.rotation();
+  const auto lidar_rotation_vector = [&](const Mat3d& body_rotation) {
+    return so3_log(R_il.transpose() * body_rotation * R_il);
+  };
+  registration::Vec6d step;
+  step << lidar_twist.head<3>() * ns_to_seconds(scan.end_stamp_ns - last_body_->stamp_ns),
+      lidar_rotation_vector(*since_last);
+  prior.guess = last_body_->pose * T_imu_lidar_ * SE3::exp(step);
+  if (scan.has_time() && scan.duration_s() > 0.0) {
+    registration::Vec6d twist;
+    twist << lidar_twist.head<3>(), lidar_rotation_vector(*during_scan) / scan.duration_s();
+    prior.motion = deskew::ScanMotion::constant_twist(twist.cast<float>(), static_cast<float>(scan.duration_s()));
   }
   return prior;
 }
 
 void FusionDriver::link(const Scan& scan, OdometryFrame& frame) {
   frame.drop_reason = drop_reason(frame.scan, last_body_.has_value());
+  if (fusion_ && (frame.scan.map_restarted || frame.scan.map_started_here)) fusion_->restart_window();
   std::optional<Mat6d> covariance;
   if (frame.scan.registered && frame.scan.registration.system.inliers > 0) {
     covariance = registration::covariance_from_information(registration::body_information(
@@ -225,11 +290,27 @@ void FusionDriver::link(const Scan& scan, OdometryFrame& frame) {
     }
   }
   const std::int64_t stamp_ns = scan.end_stamp_ns;
+  if (frame.drop_reason.empty() && fusion_ && !has_imu()) {
+    frame.drop_reason = "not fused: no IMU sample yet (LiDAR-only until the first one arrives)";
+    if (!warned_no_imu_) {
+      warn("the scan ending at " + seconds_text(ns_to_seconds(stamp_ns)) +
+           " s came before the first IMU sample: scans are registered LiDAR-only until the IMU starts");
+      warned_no_imu_ = true;
+    }
+  }
   if (frame.drop_reason.empty() && fusion_ && has_imu() && !gyro_unit_.decided() && last_body_ &&
       stamp_ns > last_body_->stamp_ns) {
     gyro_unit_.add_lidar_rotation(last_body_->stamp_ns, stamp_ns,
-                                  (last_body_->pose.inverse() * frame.body_pose).angle_rad());
+                                  so3_log((last_body_->pose.inverse() * frame.body_pose).rotation()));
     if (gyro_unit_.decided()) apply_gyro_unit();
+    if (!first_compared_ns_) first_compared_ns_ = stamp_ns;
+    if (!gyro_unit_.decided() && !warned_undecided_gyro_ &&
+        ns_to_seconds(stamp_ns - *first_compared_ns_) > kUndecidedGyroWarning_s) {
+      warn("the gyro's unit (rad/s or deg/s) is not decided after " + seconds_text(kUndecidedGyroWarning_s) +
+           " s of scans: the LiDAR has hardly turned. Until it turns, a gyro in deg/s would turn the fused "
+           "orientation 57 times too far (fusion.gyro_unit_detection)");
+      warned_undecided_gyro_ = true;
+    }
   }
   if (frame.drop_reason.empty() && fusion_ && has_imu() && !fusion_->initialized() &&
       ns_to_seconds(clock_ns_) - ns_to_seconds(stamp_ns) > fusion_config_.max_bridged_gap_s) {

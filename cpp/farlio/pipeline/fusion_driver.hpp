@@ -5,9 +5,9 @@
 // recording's IMU up to a simulated time, the online odometry each sample as it arrives.
 //   the fusion clock: IMU samples in, the EKF stepped, one odometry sample every fusion.step_s,
 //     each computed from exactly the IMU samples stamped up to its instant;
-//   before a scan: the start pose (roll and pitch from gravity) at the first scan, the fusion's
-//     pose at the scan end as the initial guess, and a regression over its pose history during
-//     the scan as the motion for the undistortion;
+//   before a scan: the start pose (roll and pitch from gravity when the first IMU samples look
+//     unaccelerated) at the first scan, the fusion's pose at the scan end as the initial guess,
+//     and a regression over its pose history during the scan as the motion for the undistortion;
 //   after a scan: the drop rules, the registration's covariance in the body frame and its
 //     degeneracy, then the registered body pose and the eq. (6) velocity go into the fusion as a
 //     (possibly delayed) measurement with that covariance.
@@ -15,15 +15,19 @@
 // fused; the drop rules still apply.
 // What the driver does not let through (docs/hardening.md, "Configuration and clocks"), each with a
 // warning (take_warnings):
-//   the IMU clock jumping by more than fusion.max_bridged_gap_s (a far-future stamp, a stamp far
-//     back): the fusion is reset and starts again from the next LiDAR result, so that no catch-up
-//     loop runs across the jump; a sample older than the newest within it is dropped, and no
-//     odometry stamp is emitted twice;
+//   a sample stamped more than fusion.max_bridged_gap_s from the newest (a far-future stamp, a
+//     stamp far back) waits for the next: if that one follows the newest, the stamp alone was
+//     wrong and the sample is dropped; if it follows the held one, the IMU clock jumped: the
+//     fusion is reset and starts again from the next LiDAR results, so that no catch-up loop runs
+//     across the jump; a sample older than the newest within the gap is dropped, and no odometry
+//     stamp is emitted twice;
 //   a LiDAR result older than the IMU clock by more than fusion.max_bridged_gap_s does not
 //     initialise the filter (the IMU and LiDAR clocks differ);
 //   a gyro in deg/s is scaled (the fusion starts again), a stuck gyro or a silent accelerometer
-//     ends the fusion (LiDAR-only): fusion/gyro_unit_detector.hpp;
-//   results before the first IMU sample are not fused (no IMU yet: LiDAR-only until it comes).
+//     ends the fusion (LiDAR-only): fusion/gyro_unit_detector.hpp; a unit still undecided after
+//     kUndecidedGyroWarning_s of scans is a warning;
+//   results before the first IMU sample are not fused (no IMU yet: LiDAR-only until it comes),
+//     with that drop reason and one warning.
 #include <cstdint>
 #include <deque>
 #include <optional>
@@ -42,17 +46,27 @@
 
 namespace farlio::pipeline {
 
-/// Roll and pitch that make the mean specific force of the first samples (the first
-/// kGravityAlignmentWindow_s, and none after until_ns: the first scan's end) point up; yaw 0.
-/// Identity without samples.
-SE3 gravity_aligned_start(const std::vector<ImuSample>& imu, std::int64_t until_ns);
+/// The map frame's attitude at the first scan: roll and pitch that make the mean specific force of
+/// the first samples (the first kGravityAlignmentWindow_s, and none after until_ns: the first
+/// scan's end) point up, yaw 0, when those samples look unaccelerated (their mean within
+/// kLevelledStartMaxAccelDeviation_m_s2 of gravity and their mean rate below max_gyro_rad_s: at
+/// rest, or at a constant velocity); else, and without samples, the identity (the body's own
+/// attitude). The fusion finds gravity in that frame either way (fusion/initialization.hpp).
+SE3 gravity_aligned_start(const std::vector<ImuSample>& imu, std::int64_t until_ns, double gravity_m_s2,
+                          double max_gyro_rad_s);
 /// Samples that gravity_aligned_start averages: those within this window of the first.
 inline constexpr double kGravityAlignmentWindow_s = 0.2;
+/// A start levelled by a mean specific force this close to gravity is off the vertical by at most
+/// about atan(sqrt(2 g d) / g): 14 deg (a horizontal acceleration of 2.4 m/s^2).
+inline constexpr double kLevelledStartMaxAccelDeviation_m_s2 = 0.3;
 
-/// What the fusion tells the scan pipeline about a scan; empty before the filter is initialised.
+/// What the fusion tells the scan pipeline about a scan: from the filter once it is initialised;
+/// before, the constant-velocity translation with the gyro's rotation (not fused: the pipeline
+/// registers it as LiDAR-only); empty without a usable gyro.
 struct ScanPrior {
   std::optional<SE3> guess;                  ///< LiDAR pose at the scan end
   std::optional<deskew::ScanMotion> motion;  ///< LiDAR motion during the scan
+  bool fused = false;                        ///< from the filter
 };
 
 /// Why a scan's result must not reach the fusion; empty when it may.
@@ -87,15 +101,17 @@ class FusionDriver {
   /// The newest IMU stamp fed, or the latest advance_to stamp (0 before either).
   [[nodiscard]] std::int64_t clock_ns() const { return clock_ns_; }
   /// The body pose the world frame starts from, for a first scan ending at first_scan_end_ns:
-  /// roll and pitch from gravity when inertial (gravity_aligned_start), else the identity.
+  /// roll and pitch from gravity when inertial and unaccelerated (gravity_aligned_start), else the
+  /// identity.
   /// With `requested` (a body pose the user gives, e.g. in a prior map): its position and yaw, and
   /// its roll and pitch too when there is no fusion (with one, the IMU measures them).
   [[nodiscard]] SE3 start_pose(std::int64_t first_scan_end_ns,
                                const std::optional<SE3>& requested = std::nullopt) const;
 
-  /// The initial guess and the motion during the scan, from the fusion (empty: LiDAR-only, or
-  /// before the filter is initialised).
-  [[nodiscard]] ScanPrior prior(const Scan& scan) const;
+  /// The initial guess and the motion during the scan (ScanPrior); lidar_twist: the scan
+  /// pipeline's constant-velocity twist (ScanPipeline::last_twist), for the translation before
+  /// the filter is initialised.
+  [[nodiscard]] ScanPrior prior(const Scan& scan, const registration::Vec6d& lidar_twist) const;
   /// After the scan pipeline (frame.scan and frame.body_pose set): sets frame.drop_reason and
   /// frame.degeneracy and, unless dropped and when inertial, fuses the result at the current clock
   /// (frame.fused).
@@ -106,11 +122,18 @@ class FusionDriver {
  private:
   /// Steps the filter to the next output instant and appends its estimate.
   void emit_step(Samples& out);
-  /// A new filter (not initialised) fed with `samples`; the output grid is kept unless `regrid`.
+  /// A new filter (not initialised) fed with `samples`, with what the old one knew of the map
+  /// frame; the output grid is kept unless `regrid`.
   void restart_fusion(const std::deque<ImuSample>& samples, bool regrid);
   /// Whether `sample` may reach the fusion: false for a sample older than the newest (dropped)
-  /// and for a silent accelerometer; a jump beyond max_bridged_gap_s restarts the fusion first.
+  /// and for a silent accelerometer.
   bool admit(const ImuSample& sample);
+  /// The sample through admit into the fusion, emitting the odometry up to its stamp.
+  void feed_imu(const ImuSample& sample, Samples& out);
+  /// How far the sample's stamp is from the newest (s; 0 before the first).
+  [[nodiscard]] double jump_s(const ImuSample& sample) const;
+  /// The IMU clock jumped to `sample`: the fusion is reset there.
+  void jump_clock(const ImuSample& sample);
   /// After the gyro unit was decided: scales and restarts, or ends the fusion.
   void apply_gyro_unit();
   /// The sample with its gyro in rad/s.
@@ -128,6 +151,10 @@ class FusionDriver {
   std::vector<Eigen::Vector3d> first_accels_;  ///< for the silent accelerometer check
   std::deque<ImuSample> recent_imu_;           ///< raw, the last history_s, re-fed when the gyro's unit changes
   std::optional<std::int64_t> newest_imu_ns_;
+  std::optional<ImuSample> held_jump_;             ///< a sample beyond the bridged gap, until the next one
+  bool warned_no_imu_ = false;                     ///< a scan came before the first IMU sample
+  std::optional<std::int64_t> first_compared_ns_;  ///< the first scan the gyro's unit was compared at
+  bool warned_undecided_gyro_ = false;
   std::int64_t clock_ns_ = 0;
   std::int64_t next_output_ns_ = 0;  ///< 0: set by the first IMU sample
   std::optional<std::int64_t> last_output_ns_;

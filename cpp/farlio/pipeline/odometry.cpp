@@ -140,9 +140,9 @@ OdometryFrame Odometry::process(const Scan& scan) {
     pipeline_.reset_initial_pose(initial_body_pose_ * T_imu_lidar_);
   }
 
-  const ScanPrior prior = driver_.prior(scan);
-  out.guess_from_fusion = prior.guess.has_value();
-  out.scan = pipeline_.process(scan, prior.guess, prior.motion);
+  const ScanPrior prior = driver_.prior(scan, pipeline_.last_twist());
+  out.guess_from_fusion = prior.guess.has_value() && prior.fused;
+  out.scan = pipeline_.process(scan, prior.guess, prior.motion, prior.fused);
   out.processed = true;
   out.body_pose = out.scan.pose * T_lidar_imu_;
   out.available_ns = out.started_ns + seconds_to_ns(latency_s(out.scan));

@@ -126,11 +126,11 @@ OdometryFrame OnlineOdometry::process(const Scan& scan) {
       started_ = true;
       pipeline_.reset_initial_pose(driver_.start_pose(scan.end_stamp_ns, requested_initial_pose_) * T_imu_lidar_);
     }
-    prior = driver_.prior(scan);
+    prior = driver_.prior(scan, pipeline_.last_twist());
     out.started_ns = fused_clock() ? driver_.clock_ns() : scan.end_stamp_ns;
   }
-  out.guess_from_fusion = prior.guess.has_value();
-  out.scan = pipeline_.process(scan, prior.guess, prior.motion);
+  out.guess_from_fusion = prior.guess.has_value() && prior.fused;
+  out.scan = pipeline_.process(scan, prior.guess, prior.motion, prior.fused);
   out.processed = true;
   out.body_pose = out.scan.pose * T_lidar_imu_;
   if (keep_registered_points_) {

@@ -18,6 +18,19 @@ double seconds_since(Clock::time_point t) { return std::chrono::duration<double>
 // Used as the LiDAR period when neither stamps nor per-point times give one (10 Hz).
 constexpr double kFallbackPeriod_s = 0.1;
 
+/// The body twist per second ([v; w]) from `from` at from_ns to `to` at to_ns (zero unless to_ns is later).
+registration::Vec6d twist_between(const SE3& from, const SE3& to, std::int64_t from_ns, std::int64_t to_ns) {
+  if (to_ns <= from_ns) return registration::Vec6d::Zero();
+  return (from.inverse() * to).log() / ns_to_seconds(to_ns - from_ns);
+}
+
+/// How far apart two motions over a scan put its first point (registration::model_error_m of the
+/// difference of their poses at the scan start).
+double motion_deviation_m(const deskew::ScanMotion& a, const deskew::ScanMotion& b, const ThresholdConfig& config) {
+  const SE3 deviation = SE3::exp(a.offset.cast<double>()).inverse() * SE3::exp(b.offset.cast<double>());
+  return registration::model_error_m(deviation, config);
+}
+
 }  // namespace
 
 ScanPipeline::ScanPipeline(const Config& config, const SE3& initial_pose)
@@ -40,9 +53,36 @@ void ScanPipeline::set_prior_map(std::vector<Eigen::Vector3f> world_points) {
 }
 
 registration::Vec6d ScanPipeline::last_twist() const {
-  if (frames_ < 2 || last_stamp_ns_ <= prev_stamp_ns_) return registration::Vec6d::Zero();
-  const double dt = ns_to_seconds(last_stamp_ns_ - prev_stamp_ns_);
-  return (prev_pose_.inverse() * last_pose_).log() / dt;
+  if (frames_ < 2) return registration::Vec6d::Zero();
+  return twist_between(prev_pose_, last_pose_, prev_stamp_ns_, last_stamp_ns_);
+}
+
+std::string ScanPipeline::register_frame(FrameResult& out, const SE3& guess, bool fused_guess,
+                                         std::size_t source_points, double time_budget_s) {
+  // the spacing as the backends' maps hold it (float)
+  const auto spacing_m = static_cast<float>(map::point_spacing_m(config_.map));
+  const double p2p =
+      registration::point_to_point_precision(config_.registration, config_.map.covariance_epsilon, spacing_m);
+  // Degenerate directions are held only at a prediction from another sensor (the fusion's
+  // guess): LiDAR-only, the constant-velocity model knows less than the scan's weak constraint
+  // (racetrack launch seed 2: APE 0.16 -> 1.12 m when held there).
+  RegistrationConfig reg = config_.registration;
+  reg.hold_degenerate_directions = reg.hold_degenerate_directions && fused_guess;
+  // The kernel scale sigma / 3 follows the constant-velocity model's deviations; the fusion's
+  // guess deviates far less than sigma says (registration.fused_kernel_scale_m).
+  registration::Thresholds thresholds = registration::Thresholds::from_sigma(out.sigma_m, p2p);
+  if (fused_guess)
+    thresholds.kernel_scale_m = std::min(thresholds.kernel_scale_m, config_.registration.fused_kernel_scale_m);
+  out.kernel_scale_m = thresholds.kernel_scale_m;
+  out.registration = backend_->register_source(guess, thresholds, reg, time_budget_s);
+  out.registered = true;
+  out.inlier_fraction = static_cast<double>(out.registration.system.inliers) / static_cast<double>(source_points);
+  std::string failure = registration::failure_reason(out.registration, source_points, config_.registration);
+  if (failure.empty() && localizing() && out.inlier_fraction < config_.localization.min_inlier_fraction) {
+    failure = "not localized: " + std::to_string(static_cast<int>(100.0 * out.inlier_fraction)) +
+              " % of the points match the prior map (localization.min_inlier_fraction)";
+  }
+  return failure;
 }
 
 SE3 ScanPipeline::predict(std::int64_t stamp_ns) const {
@@ -64,12 +104,20 @@ bool ScanPipeline::restart_map_after_failures(std::int64_t stamp_ns, const Frame
   return true;
 }
 
-FrameResult ScanPipeline::process(const Scan& scan, const std::optional<SE3>& initial_guess,
-                                  const std::optional<deskew::ScanMotion>& motion) {
+FrameResult ScanPipeline::process(const Scan& input, const std::optional<SE3>& initial_guess,
+                                  const std::optional<deskew::ScanMotion>& motion, bool guess_from_fusion) {
   auto t_start = Clock::now();
   FrameResult out;
-  out.stamp_ns = scan.end_stamp_ns;
-  out.input_points = scan.size();
+  out.stamp_ns = input.end_stamp_ns;
+  out.input_points = input.size();
+  // points with NaN or Inf coordinates or times are dropped, as the readers drop them (a NaN time
+  // has no place in the undistortion)
+  std::optional<Scan> finite;
+  if (!input.all_finite()) {
+    finite = input;
+    out.non_finite_points = finite->remove_non_finite();
+  }
+  const Scan& scan = finite ? *finite : input;
 
   // 0. the first scan with points fixes the map's scale
   if (!scale_fixed_ && !scan.empty()) {
@@ -124,36 +172,37 @@ FrameResult ScanPipeline::process(const Scan& scan, const std::optional<SE3>& in
                               ? ns_to_seconds(scan.end_stamp_ns - last_stamp_ns_)
                               : (scan.duration_s() > 0 ? scan.duration_s() : kFallbackPeriod_s);
   out.initial_guess = initial_guess ? *initial_guess : predict(scan.end_stamp_ns);
-  out.sigma_m = threshold_.sigma_m();
+  // The first registration has no motion model: its constant-velocity guess assumes rest. A body
+  // that already moves (a recording cut at speed: 3.5 m a scan at 70 m/s and 20 Hz) is found
+  // with correspondences as far as the adaptive threshold's cap.
+  const bool fused_guess = initial_guess.has_value() && guess_from_fusion;
+  const bool motion_unknown = frames_ == 1 && !fused_guess && !localizing();
+  out.sigma_m = motion_unknown
+                    ? std::max(threshold_.sigma_m(), registration::sigma_without_motion_model_m(config_.threshold))
+                    : threshold_.sigma_m();
   SE3 pose = out.initial_guess;
   if (backend_->map_voxels() > 0 && source.points > 0) {
-    // the spacing as the backends' maps hold it (float)
-    const auto spacing_m = static_cast<float>(map::point_spacing_m(config_.map));
-    const double p2p =
-        registration::point_to_point_precision(config_.registration, config_.map.covariance_epsilon, spacing_m);
-    // Degenerate directions are held only at a prediction from another sensor (the fusion's
-    // guess): LiDAR-only, the constant-velocity model knows less than the scan's weak constraint
-    // (racetrack launch seed 2: APE 0.16 -> 1.12 m when held there).
-    RegistrationConfig reg = config_.registration;
-    reg.hold_degenerate_directions = reg.hold_degenerate_directions && initial_guess.has_value();
-    // The kernel scale sigma / 3 follows the constant-velocity model's deviations; the fusion's
-    // guess deviates far less than sigma says (registration.fused_kernel_scale_m).
-    registration::Thresholds thresholds = registration::Thresholds::from_sigma(out.sigma_m, p2p);
-    if (initial_guess)
-      thresholds.kernel_scale_m = std::min(thresholds.kernel_scale_m, config_.registration.fused_kernel_scale_m);
-    out.kernel_scale_m = thresholds.kernel_scale_m;
-    out.registration = backend_->register_source(out.initial_guess, thresholds, reg,
-                                                 config_.registration.time_budget_factor * period_s);
-    out.registered = true;
-    out.inlier_fraction = static_cast<double>(out.registration.system.inliers) / static_cast<double>(source.points);
-    out.failure = registration::failure_reason(out.registration, source.points, config_.registration);
-    if (out.failure.empty() && localizing() && out.inlier_fraction < config_.localization.min_inlier_fraction) {
-      out.failure = "not localized: " + std::to_string(static_cast<int>(100.0 * out.inlier_fraction)) +
-                    " % of the points match the prior map (localization.min_inlier_fraction)";
-    }
+    const double time_budget_s = config_.registration.time_budget_factor * period_s;
+    out.failure = register_frame(out, out.initial_guess, fused_guess, source.points, time_budget_s);
     if (out.failure.empty()) {
       pose = out.registration.pose;
       threshold_.update(out.initial_guess.inverse() * pose);
+    }
+    // The first scan and this one were undistorted without the motion just found. Both are
+    // smeared alike, so the registration of one against the other stands; the map starts again
+    // from this scan undistorted with that motion (the first scan leaves it).
+    if (motion_unknown && out.failure.empty() && config_.preprocess.undistort && scan.has_time()) {
+      const deskew::ScanMotion found = deskew::ScanMotion::constant_twist(
+          twist_between(last_pose_, pose, last_stamp_ns_, scan.end_stamp_ns).cast<float>(),
+          static_cast<float>(scan.duration_s()));
+      if (motion_deviation_m(scan_motion, found, config_.threshold) > config_.threshold.min_motion_m) {
+        out.motion = found;
+        out.undistorted = true;
+        out.kept_points = backend_->preprocess(scan, found, true);
+        out.source_points = backend_->build_source(config_.density.close_range_m, false).points;
+        backend_->reset(config_);
+        out.map_started_here = true;
+      }
     }
   } else if (backend_->map_voxels() > 0) {
     out.failure = "nothing to register against (no points after preprocessing)";

@@ -39,6 +39,9 @@ struct FrameResult {
   /// non-finite pose. The scan then keeps the predicted pose and changes no state.
   std::string failure;
   bool map_restarted = false;  ///< the map was restarted from this scan (after failures, recovery)
+  /// The first registration found the body moving: this scan was undistorted again with that
+  /// motion and the map started again from it (the first scan, undistorted without it, left).
+  bool map_started_here = false;
   /// Inliers over source points of the registration (0 when not registered).
   double inlier_fraction = 0;
   /// Localization in a prior map: the scan did not match the map (a failure, or an inlier
@@ -50,6 +53,9 @@ struct FrameResult {
   double kernel_scale_m = 0;  ///< Cauchy kernel scale used (sigma / 3, or registration.fused_kernel_scale_m)
   int density_limit = 0;      ///< close-range per-voxel limit chosen by ASMD
   std::size_t input_points = 0, kept_points = 0, source_points = 0;
+  /// Points dropped before the preprocessing for NaN or Inf coordinates or times (the readers
+  /// drop them; a scan handed to the API may still have them).
+  std::size_t non_finite_points = 0;
   map::InsertStats map_insert;
   std::size_t map_voxels = 0, map_points = 0, removed_voxels = 0;
   FrameTimings timings;
@@ -69,8 +75,11 @@ class ScanPipeline {
 
   /// Registers one scan. `initial_guess` (world pose at the scan end) and `motion` (for the
   /// undistortion) come from the fusion; when absent, the constant-velocity model supplies them.
-  FrameResult process(const Scan& scan, const std::optional<SE3>& initial_guess = std::nullopt,
-                      const std::optional<deskew::ScanMotion>& motion = std::nullopt);
+  /// guess_from_fusion false: the guess is a LiDAR-only one (the constant-velocity translation
+  /// with the gyro's rotation, before the filter is initialised) and registered as such.
+  /// Points with NaN or Inf coordinates or times are dropped (FrameResult::non_finite_points).
+  FrameResult process(const Scan& input, const std::optional<SE3>& initial_guess = std::nullopt,
+                      const std::optional<deskew::ScanMotion>& motion = std::nullopt, bool guess_from_fusion = true);
 
   /// Replaces the initial pose; only before the first scan (throws std::logic_error after).
   void reset_initial_pose(const SE3& initial_pose);
@@ -96,6 +105,11 @@ class ScanPipeline {
   [[nodiscard]] registration::Vec6d last_twist() const;
 
  private:
+  /// GICP of the frame's source from `guess` at out.sigma_m (sets out.registration, registered,
+  /// inlier_fraction, kernel_scale_m); returns why its pose must not be used (empty when it may).
+  /// fused_guess: the guess is the fusion's.
+  std::string register_frame(FrameResult& out, const SE3& guess, bool fused_guess, std::size_t source_points,
+                             double time_budget_s);
   /// Tracks failures in a row; after map_restart_after_s of them, empties the submap (a scan with
   /// points then starts it again) and returns true.
   bool restart_map_after_failures(std::int64_t stamp_ns, const FrameResult& result);

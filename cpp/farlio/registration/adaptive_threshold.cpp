@@ -5,6 +5,10 @@
 
 namespace farlio::registration {
 
+double model_error_m(const SE3& deviation, const ThresholdConfig& config) {
+  return deviation.translation().norm() + 2.0 * config.max_range_m * std::sin(0.5 * deviation.angle_rad());
+}
+
 AdaptiveThreshold::AdaptiveThreshold(const ThresholdConfig& config)
     // The initial threshold counts as one sample (as the reference does).
     : config_(config), sum_squared_error_(config.initial_threshold_m * config.initial_threshold_m), num_samples_(1.0) {}
@@ -14,8 +18,7 @@ double AdaptiveThreshold::sigma_m() const {
 }
 
 double AdaptiveThreshold::update(const SE3& deviation) {
-  const double error =
-      deviation.translation().norm() + 2.0 * config_.max_range_m * std::sin(0.5 * deviation.angle_rad());
+  const double error = model_error_m(deviation, config_);
   if (error > config_.min_motion_m) {
     sum_squared_error_ += error * error;
     num_samples_ += 1.0;

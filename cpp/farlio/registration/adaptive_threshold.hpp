@@ -7,6 +7,14 @@
 
 namespace farlio::registration {
 
+/// The model error of a deviation (initial guess^-1 * registered, or between two motions): its
+/// translation plus the displacement its rotation causes at config.max_range_m (m).
+double model_error_m(const SE3& deviation, const ThresholdConfig& config);
+
+/// Sigma of a registration without a motion model (the first one, whose guess assumes rest): its
+/// correspondences reach max_threshold_m (3 sigma).
+inline double sigma_without_motion_model_m(const ThresholdConfig& config) { return config.max_threshold_m / 3.0; }
+
 class AdaptiveThreshold {
  public:
   explicit AdaptiveThreshold(const ThresholdConfig& config);

@@ -9,6 +9,7 @@ from pathlib import Path
 from farlio.cli_args import add_config_arguments, non_negative_float, non_negative_int, positive_float, positive_int
 from farlio.config import load_config
 from farlio.datasets import FORMAT_HELP, FORMATS, LoadOptions, TimeOptions, open_dataset
+from farlio.datasets.cut import StartCut
 from farlio.datasets.pointcloud2 import HEADER_STAMPS, TIME_FIELDS, TIME_UNITS
 from farlio.mapping import MapOptions
 from farlio.runner import DEVICES, format_summary, replay_options, run_dataset
@@ -30,6 +31,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "when one is present and falls back to the CPU with a message; cuda without one is an error",
     )
     parser.add_argument("--max-frames", type=positive_int, default=None, help="stop after this many scans")
+    parser.add_argument(
+        "--start",
+        type=non_negative_float,
+        default=0.0,
+        metavar="S",
+        help="skip the recording's first S seconds (from its first scan's start): the run begins with the first "
+        "scan that starts then, with the IMU from then on, as a recording cut there would (the vehicle may be "
+        "moving: the filter then initialises in motion, summary.json initialization)",
+    )
     parser.add_argument(
         "--gt",
         type=Path,
@@ -176,6 +186,8 @@ def run(args: argparse.Namespace) -> int:
         viewer = RerunViewer(args.out)
         print(f"live view: {viewer.where}")
     dataset = open_dataset(args.path, args.format, load_options(args))
+    if args.start > 0.0:
+        dataset = StartCut(dataset, args.start)
     summary = run_dataset(
         dataset,
         args.out,
