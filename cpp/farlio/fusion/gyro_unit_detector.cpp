@@ -16,7 +16,7 @@ constexpr double kKeptIntegral_s = 5.0;
 /// on one side of the midpoint between the units and around that unit's value, after
 /// kMinRegressionIntervals intervals.
 constexpr double kRegressionSigmas = 6.0;
-constexpr int kMinRegressionIntervals = 20;
+constexpr int kMinRegressionIntervals = 8;
 /// Beyond their standard error, the slope may miss its unit's value by this much (the gyro's
 /// scale factor, the LiDAR's and the IMU's timing).
 constexpr double kSlopeTolerance = 0.2;

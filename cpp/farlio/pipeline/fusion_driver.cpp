@@ -15,6 +15,12 @@ namespace {
 
 // Poses sampled over a scan for the motion regression.
 constexpr int kMotionSamples = 11;
+/// While the gyro's unit is undecided, the gyro turns the guess before the filter only when it
+/// turned no more than this many times as far as the LiDAR between the last two scans (the
+/// midpoint between rad/s and deg/s, sqrt(180/pi)), give or take this much (rotations of the
+/// order of the LiDAR's noise, which a deg/s gyro's noise also reaches at rest).
+constexpr double kRotationAgreementRatio = 7.57;
+constexpr double kRotationAgreementFloor_rad = 0.01;
 /// A gyro whose unit is not decided after this much time comparing it with the LiDAR gets a warning.
 constexpr double kUndecidedGyroWarning_s = 10.0;
 /// Warnings kept between two take_warnings calls; later ones are left out (a last one says so).
@@ -243,10 +249,10 @@ SE3 FusionDriver::start_pose(std::int64_t first_scan_end_ns, const std::optional
 ScanPrior FusionDriver::prior(const Scan& scan, const registration::Vec6d& lidar_twist) const {
   ScanPrior prior;
   if (!fusion_) return prior;
-  // while the gyro's unit is undecided, a scan during which it turns is registered by the LiDAR
-  // alone: a deg/s gyro would turn the guess 57 times too far (and the registration would follow)
-  if (gyro_unit_.turning(scan.start_stamp_ns, scan.end_stamp_ns)) return prior;
   if (fusion_->initialized()) {
+    // while the gyro's unit is undecided, a scan during which it turns is registered by the LiDAR
+    // alone: a deg/s gyro would turn the guess 57 times too far (and the registration would follow)
+    if (gyro_unit_.turning(scan.start_stamp_ns, scan.end_stamp_ns)) return prior;
     if (const auto body = fusion_->pose_at(scan.end_stamp_ns)) {
       prior.guess = *body * T_imu_lidar_;
       prior.motion = motion_from_fusion(*fusion_, scan, *prior.guess, T_imu_lidar_);
@@ -254,8 +260,10 @@ ScanPrior FusionDriver::prior(const Scan& scan, const registration::Vec6d& lidar
     }
     return prior;
   }
-  // before the filter: the constant-velocity translation, turned as the gyro turned
-  if (!gyro_unit_.decided() || !last_body_ || scan.end_stamp_ns <= last_body_->stamp_ns) return prior;
+  // before the filter: the constant-velocity translation, turned as the gyro turned (while its unit
+  // is undecided, as long as it turned as the LiDAR did between the last two scans)
+  if (!(gyro_unit_.decided() || gyro_follows_lidar_) || !last_body_ || scan.end_stamp_ns <= last_body_->stamp_ns)
+    return prior;
   const auto since_last = fusion_->imu_rotation(last_body_->stamp_ns, scan.end_stamp_ns);
   const auto during_scan = fusion_->imu_rotation(scan.start_stamp_ns, scan.end_stamp_ns);
   if (!since_last || !during_scan) return prior;
@@ -300,8 +308,12 @@ void FusionDriver::link(const Scan& scan, OdometryFrame& frame) {
   }
   if (frame.drop_reason.empty() && fusion_ && has_imu() && !gyro_unit_.decided() && last_body_ &&
       stamp_ns > last_body_->stamp_ns) {
-    gyro_unit_.add_lidar_rotation(last_body_->stamp_ns, stamp_ns,
-                                  so3_log((last_body_->pose.inverse() * frame.body_pose).rotation()));
+    const Eigen::Vector3d lidar_rotation = so3_log((last_body_->pose.inverse() * frame.body_pose).rotation());
+    const auto gyro_rotation = fusion_->imu_rotation(last_body_->stamp_ns, stamp_ns);
+    gyro_follows_lidar_ =
+        gyro_rotation &&
+        so3_log(*gyro_rotation).norm() <= kRotationAgreementRatio * lidar_rotation.norm() + kRotationAgreementFloor_rad;
+    gyro_unit_.add_lidar_rotation(last_body_->stamp_ns, stamp_ns, lidar_rotation);
     if (gyro_unit_.decided()) apply_gyro_unit();
     if (!first_compared_ns_) first_compared_ns_ = stamp_ns;
     if (!gyro_unit_.decided() && !warned_undecided_gyro_ &&

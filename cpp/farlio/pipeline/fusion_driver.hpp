@@ -154,6 +154,7 @@ class FusionDriver {
   std::optional<ImuSample> held_jump_;             ///< a sample beyond the bridged gap, until the next one
   bool warned_no_imu_ = false;                     ///< a scan came before the first IMU sample
   std::optional<std::int64_t> first_compared_ns_;  ///< the first scan the gyro's unit was compared at
+  bool gyro_follows_lidar_ = false;                ///< the gyro turned as the LiDAR between the last two scans
   bool warned_undecided_gyro_ = false;
   std::int64_t clock_ns_ = 0;
   std::int64_t next_output_ns_ = 0;  ///< 0: set by the first IMU sample
