@@ -78,13 +78,12 @@ MapFrameKnowledge SensorFusion::map_frame_knowledge() const {
   MapFrameKnowledge k;
   k.window = window_;
   if (!level_from_map_) return k;
-  const Eigen::Matrix3d map_from_level = level_from_map_->transpose();
   if (!initialized()) {
-    k.gravity_map_m_s2 = map_from_level * Eigen::Vector3d(0.0, 0.0, -gravity_m_s2_);
+    k.gravity_map_m_s2 = map_from_level() * Eigen::Vector3d(0.0, 0.0, -gravity_m_s2_);
     k.tilt_std_rad = known_tilt_std_rad_;
     return k;
   }
-  k.gravity_map_m_s2 = map_from_level * world_gravity(ekf_.state(), gravity_m_s2_);
+  k.gravity_map_m_s2 = map_from_level() * world_gravity(ekf_.state(), gravity_m_s2_);
   k.tilt_std_rad = std::sqrt(ekf_.covariance().block<2, 2>(kTiltIndex, kTiltIndex).diagonal().maxCoeff());
   return k;
 }
@@ -241,15 +240,18 @@ void SensorFusion::initialize_known(std::int64_t stamp_ns, const SE3& body_pose,
   report.speed_m_s = velocity_body_m_s.norm();
 }
 
+Eigen::Matrix3d SensorFusion::map_from_level() const {
+  return level_from_map_ ? Eigen::Matrix3d(level_from_map_->transpose()) : Eigen::Matrix3d::Identity();
+}
+
 SE3 SensorFusion::to_level(const SE3& map_pose) const {
-  if (!level_from_map_) return map_pose;
-  return {*level_from_map_ * map_pose.rotation(), *level_from_map_ * map_pose.translation()};
+  const Eigen::Matrix3d R = map_from_level().transpose();
+  return {R * map_pose.rotation(), R * map_pose.translation()};
 }
 
 SE3 SensorFusion::to_map(const SE3& level_pose) const {
-  if (!level_from_map_) return level_pose;
-  const Eigen::Matrix3d map_from_level = level_from_map_->transpose();
-  return {map_from_level * level_pose.rotation(), map_from_level * level_pose.translation()};
+  const Eigen::Matrix3d R = map_from_level();
+  return {R * level_pose.rotation(), R * level_pose.translation()};
 }
 
 void SensorFusion::add_to_window(std::int64_t stamp_ns, const SE3& body_pose) {
@@ -295,7 +297,7 @@ bool SensorFusion::initialize_from_window() {
   AlignmentOptions options;
   options.gravity_m_s2 = gravity_m_s2_;
   options.step_ns = step_ns_;
-  if (level_from_map_) options.gravity_map_m_s2 = level_from_map_->transpose() * Eigen::Vector3d(0, 0, -gravity_m_s2_);
+  if (level_from_map_) options.gravity_map_m_s2 = map_from_level() * Eigen::Vector3d(0.0, 0.0, -gravity_m_s2_);
   const bool at_rest = window_at_rest();
   const double span_s = ns_to_seconds(window_.back().stamp_ns - window_.front().stamp_ns);
   if (at_rest) {  // gravity is the mean specific force, the velocity zero: two results suffice
@@ -326,7 +328,7 @@ bool SensorFusion::initialize_from_window() {
     report.window_s = span_s;
     report.speed_m_s = alignment->velocity_map_m_s.norm();
     report.gravity_norm_error = alignment->gravity_norm_error;
-    report.up_map = level_from_map_->transpose() * Eigen::Vector3d::UnitZ();
+    report.up_map = map_from_level() * Eigen::Vector3d::UnitZ();
     report.map_tilt_deg = std::acos(std::clamp(report.up_map.z(), -1.0, 1.0)) * 180.0 / M_PI;
   }
   return true;
@@ -452,11 +454,8 @@ FusionStats SensorFusion::stats() const {
     s.accel_bias_m_s2 += ekf_.state().segment<3>(kAccelBiasIndex);
   }
   s.bias_samples = static_cast<std::int64_t>(bias_.sample_count());
-  if (initialized()) {
-    const Eigen::Matrix3d map_from_world =
-        level_from_map_ ? Eigen::Matrix3d(level_from_map_->transpose()) : Eigen::Matrix3d::Identity();
-    s.up_map = map_from_world * level_from_world(ekf_.state()).transpose() * Eigen::Vector3d::UnitZ();
-  }
+  if (initialized())
+    s.up_map = map_from_level() * level_from_world(ekf_.state()).transpose() * Eigen::Vector3d::UnitZ();
   return s;
 }
 

@@ -131,6 +131,8 @@ class SensorFusion {
   [[nodiscard]] bool window_at_rest() const;
   /// The mean IMU input over [start_ns, end_ns] with the biases removed, for the alignment.
   [[nodiscard]] std::optional<ImuMean> imu_mean(std::int64_t start_ns, std::int64_t end_ns) const;
+  /// The rotation from the filter's level frame to the map frame (the identity before gravity is known).
+  [[nodiscard]] Eigen::Matrix3d map_from_level() const;
   /// A map-frame pose in the filter's level frame, and back.
   [[nodiscard]] SE3 to_level(const SE3& map_pose) const;
   [[nodiscard]] SE3 to_map(const SE3& level_pose) const;
