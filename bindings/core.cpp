@@ -171,6 +171,8 @@ void bind_core(nb::module_& m) {
           "(N, 4, 4) pose matrices (a copy)")
       .def("interpolate_at", &Trajectory::interpolate_at, "stamp_ns"_a)
       .def("transformed", &Trajectory::transformed, "extrinsic"_a)
+      .def("between", &Trajectory::between, "begin_ns"_a, "end_ns"_a,
+           "The poses stamped within [begin_ns, end_ns] (a stretch of the run).")
       .def("path_length_m", &Trajectory::path_length_m)
       .def("is_time_ordered", &Trajectory::is_time_ordered)
       .def("__repr__", &trajectory_repr);

@@ -35,16 +35,6 @@ FIXED_LATENCY_S = "0.02"
 ESTIMATE, GROUNDTRUTH = "scans_body.tum", "groundtruth.tum"
 
 
-def crop(traj, begin_ns: int, end_ns: int):
-    """The poses of traj with stamps in [begin_ns, end_ns]."""
-    out = _core.Trajectory()
-    for i in range(len(traj)):
-        stamp, pose = traj[i]
-        if begin_ns <= stamp <= end_ns:
-            out.push_back(stamp, pose)
-    return out
-
-
 def along_track_error_m(est, gt, anchor_ns: int, at_ns: int) -> float:
     """(P_a^-1 P - Q_a^-1 Q) projected on the track direction (the true body x axis at at_ns)."""
     rel_est = est.interpolate_at(anchor_ns).inverse() * est.interpolate_at(at_ns)
@@ -60,7 +50,7 @@ def measure(seq: Path, run_dir: Path, meta: dict) -> dict[str, float]:
     t0_ns = int(meta["start_stamp_ns"])
     bare0 = t0_ns + round(float(meta["featureless_start_s"]) * _core.NS_PER_S)
     bare1 = t0_ns + round(float(meta["featureless_end_s"]) * _core.NS_PER_S)
-    bare = result_to_dict(_core.eval.evaluate(crop(est, bare0, bare1), gt, make_options()))
+    bare = result_to_dict(_core.eval.evaluate(est.between(bare0, bare1), gt, make_options()))
     first = est[0][0]
     return {
         "APE": whole["ape"]["translation_m"]["rmse"],

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import time
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
 
@@ -121,12 +122,23 @@ class Recording:
         self.speed_at_start_m_s = float(np.linalg.norm(gen.state(config.start_stamp_ns).velocity_world_m_s))
 
 
-def replay(rec: Recording, overrides: list[str], *, from_s: float = 0.0, fixed_latency_s: float = 0.02) -> dict:
-    """The deterministic replay of `rec` (fixed latency) with config overrides "name=value"; the
-    accuracy of its scan poses and 100 Hz odometry over the stamps from `from_s` seconds on (a
-    stretch of the recording), what happened to its frames there, how the filter started, and
-    how far its estimate of up is from the truth in its map frame at the end (deg)."""
-    from .evaluation import make_options
+@dataclass
+class ReplayRun:
+    """A replay of a Recording: its trajectories and what happened to its frames."""
+
+    rec: Recording
+    scans: Any  # _core.Trajectory of the body poses at the scan ends
+    odometry: Any  # _core.Trajectory of the 100 Hz fused odometry
+    #: per processed frame: (scan end stamp, registration failed, map restarted after failures)
+    frames: list[tuple[int, bool, bool]]
+    first_scan_ns: int | None
+    first_output_ns: int | None
+    stats: Any  # FusionStats (None LiDAR-only)
+    world_from_map: Any  # rotation: the generator's world from the odometry's map frame
+
+
+def replay(rec: Recording, overrides: list[str], *, fixed_latency_s: float = 0.02) -> ReplayRun:
+    """The deterministic replay of `rec` (fixed latency) with config overrides "name=value"."""
     from .runner import replay_options
 
     config = _core.Config()
@@ -135,55 +147,66 @@ def replay(rec: Recording, overrides: list[str], *, from_s: float = 0.0, fixed_l
         config.set(name, value)
     imu = rec.imu if config.get("fusion.enabled") else []
     odo = _core.Odometry(config, rec.T_imu_lidar, rec.gravity_m_s2, imu, replay_options("fixed", fixed_latency_s))
-    from_ns = rec.start_stamp_ns + round(from_s * 1e9)
-    scans, odometry = _core.Trajectory(), _core.Trajectory()
-    out = {"failed": 0, "map_restarts": 0, "first_output_s": math.nan}
-    first_scan_ns = first_output_ns = None
-    world_from_map = None  # the generator's world from the odometry's map frame (the first scan's)
+    run = ReplayRun(rec, _core.Trajectory(), _core.Trajectory(), [], None, None, None, None)
 
     def take_odometry() -> None:
-        nonlocal first_output_ns
         for stamp, pose in odo.take_odometry():
-            first_output_ns = stamp if first_output_ns is None else first_output_ns
-            if stamp >= from_ns:
-                odometry.push_back(stamp, pose)
+            run.first_output_ns = stamp if run.first_output_ns is None else run.first_output_ns
+            run.odometry.push_back(stamp, pose)
 
     for i, scan in enumerate(rec.scans):
         fr = odo.process(scan)
         take_odometry()
         if not fr.processed:
             continue
-        if first_scan_ns is None:
-            first_scan_ns = scan.end_stamp_ns
-            world_from_map = rec.gt_scans[i][1].rotation() @ fr.body_pose.rotation().T
-        if scan.end_stamp_ns >= from_ns:
-            scans.push_back(scan.end_stamp_ns, fr.body_pose)
-            out["failed"] += int(bool(fr.scan.failure))
-            out["map_restarts"] += int(fr.scan.map_restarted)
+        if run.first_scan_ns is None:
+            run.first_scan_ns = scan.end_stamp_ns
+            run.world_from_map = rec.gt_scans[i][1].rotation() @ fr.body_pose.rotation().T
+        run.scans.push_back(scan.end_stamp_ns, fr.body_pose)
+        run.frames.append((scan.end_stamp_ns, bool(fr.scan.failure), fr.scan.map_restarted))
     odo.finish(rec.scans[-1].end_stamp_ns)
     take_odometry()
+    run.stats = odo.fusion_stats
+    return run
+
+
+def stretch_accuracy(run: ReplayRun, from_s: float = 0.0, to_s: float = math.inf) -> dict:
+    """A replay's accuracy over the stretch [from_s, to_s] of its recording (s after its start): APE
+    (aligned RMSE, m), KITTI-style RPE (%) and rotation RMSE (deg) of the scan poses, APE and RPE of
+    the 100 Hz odometry, the frames that failed or restarted the map there; for the whole run, the
+    first fused output after the first scan (s), how the filter started and how far its estimate of
+    up is from the truth in the map frame, then and at the end (deg)."""
+    from .evaluation import make_options
+
+    t0 = run.rec.start_stamp_ns
+    from_ns = t0 + round(from_s * 1e9)
+    to_ns = t0 + round(to_s * 1e9) if math.isfinite(to_s) else np.iinfo(np.int64).max
     options = make_options()
-    r = _core.eval.evaluate(scans, rec.gt_scans, options)
-    out |= {
+    r = _core.eval.evaluate(run.scans.between(from_ns, to_ns), run.rec.gt_scans, options)
+    out = {
         "ape_m": r.ape.translation_m.rmse,
         "rpe_pct": r.kitti_rpe.translation_pct,
         "rot_deg": r.ape.rotation_deg.rmse,
     }
-    out |= {"odom_ape_m": math.nan, "odom_rpe_pct": math.nan}
+    inside = [f for f in run.frames if from_ns <= f[0] <= to_ns]
+    out |= {"failed": sum(f[1] for f in inside), "map_restarts": sum(f[2] for f in inside)}
+    out |= {"odom_ape_m": math.nan, "odom_rpe_pct": math.nan, "first_output_s": math.nan}
+    odometry = run.odometry.between(from_ns, to_ns)
     if len(odometry) > 2:
-        ro = _core.eval.evaluate(odometry, rec.gt_body, options)
+        ro = _core.eval.evaluate(odometry, run.rec.gt_body, options)
         out |= {"odom_ape_m": ro.ape.translation_m.rmse, "odom_rpe_pct": ro.kitti_rpe.translation_pct}
-    if first_output_ns is not None and first_scan_ns is not None:
-        out["first_output_s"] = (first_output_ns - first_scan_ns) / 1e9
-    stats = odo.fusion_stats
-    if stats is not None:
-        out["reinit"], out["rejected"] = stats.reinitializations, stats.lidar_groups_rejected
-        out["initialization"] = stats.initialization
-        true_up = world_from_map.T @ np.array([0.0, 0.0, 1.0])
-        out["up_error_deg"] = math.degrees(math.acos(min(1.0, float(true_up @ np.asarray(stats.up_map)))))
-        out["initial_up_error_deg"] = math.degrees(
-            math.acos(min(1.0, float(true_up @ np.asarray(stats.initialization.up_map))))
-        )
+    if run.first_output_ns is not None and run.first_scan_ns is not None:
+        out["first_output_s"] = (run.first_output_ns - run.first_scan_ns) / 1e9
+    if run.stats is not None:
+        out["reinit"], out["rejected"] = run.stats.reinitializations, run.stats.lidar_groups_rejected
+        out["initialization"] = run.stats.initialization
+        true_up = run.world_from_map.T @ np.array([0.0, 0.0, 1.0])
+
+        def off_deg(up: Any) -> float:
+            return math.degrees(math.acos(min(1.0, float(true_up @ np.asarray(up)))))
+
+        out["up_error_deg"] = off_deg(run.stats.up_map)
+        out["initial_up_error_deg"] = off_deg(run.stats.initialization.up_map)
     return out
 
 
@@ -195,6 +218,7 @@ __all__ = [
     "generate",
     "make_config",
     "replay",
+    "stretch_accuracy",
     "write_sequence",
     "farlio",
 ]

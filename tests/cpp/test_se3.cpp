@@ -74,3 +74,15 @@ TEST(Trajectory, InterpolatesAndRefusesToExtrapolate) {
   EXPECT_TRUE(t.is_time_ordered());
   EXPECT_NEAR(t.path_length_m(), SE3::exp(xi).translation().norm(), 1e-12);
 }
+
+TEST(Trajectory, BetweenKeepsTheStretchWithItsBounds) {
+  Trajectory t;
+  for (std::int64_t k = 0; k < 10; ++k)
+    t.push_back(k * 100, SE3(Eigen::Quaterniond::Identity(), Eigen::Vector3d(static_cast<double>(k), 0, 0)));
+  const Trajectory s = t.between(200, 500);
+  ASSERT_EQ(s.size(), 4u);
+  EXPECT_EQ(s[0].stamp_ns, 200);
+  EXPECT_EQ(s[3].stamp_ns, 500);
+  EXPECT_EQ(s[3].pose.translation().x(), 5.0);
+  EXPECT_TRUE(t.between(1000, 2000).empty());
+}

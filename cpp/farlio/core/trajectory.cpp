@@ -31,6 +31,14 @@ Trajectory Trajectory::transformed(const SE3& extrinsic) const {
   return out;
 }
 
+Trajectory Trajectory::between(std::int64_t begin_ns, std::int64_t end_ns) const {
+  Trajectory out;
+  for (const auto& p : poses_) {
+    if (p.stamp_ns >= begin_ns && p.stamp_ns <= end_ns) out.push_back(p.stamp_ns, p.pose);
+  }
+  return out;
+}
+
 double Trajectory::path_length_m() const {
   double len = 0.0;
   for (std::size_t i = 1; i < poses_.size(); ++i) {

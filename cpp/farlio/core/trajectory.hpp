@@ -33,6 +33,8 @@ class Trajectory {
   [[nodiscard]] std::optional<SE3> interpolate_at(std::int64_t stamp_ns) const;
   /// Every pose right-multiplied by `extrinsic` (e.g. body poses -> LiDAR poses with T_body_lidar).
   [[nodiscard]] Trajectory transformed(const SE3& extrinsic) const;
+  /// The poses stamped within [begin_ns, end_ns] (a stretch of the run).
+  [[nodiscard]] Trajectory between(std::int64_t begin_ns, std::int64_t end_ns) const;
   /// Path length in metres (sum of translation increments).
   [[nodiscard]] double path_length_m() const;
 
