@@ -48,10 +48,12 @@ inline Scan thinned(const Scan& s, std::size_t k) {
   return out;
 }
 
-/// `duration_s` of a profile, every `keep_every`-th point of each scan.
-inline Recording record(sim::Profile profile, double duration_s, std::size_t keep_every) {
+/// `duration_s` of a profile from `motion_start_s` into its motion, every `keep_every`-th point of
+/// each scan.
+inline Recording record(sim::Profile profile, double duration_s, std::size_t keep_every, double motion_start_s = 0.0) {
   sim::SimConfig cfg = sim::default_config(profile);
   cfg.duration_s = duration_s;
+  cfg.motion_start_s = motion_start_s;
   const sim::SequenceGenerator gen(cfg);
   Recording r;
   // the generator's TBB loops: in an arena of one thread under TSan (kThreadSanitized)

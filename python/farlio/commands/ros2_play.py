@@ -5,7 +5,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from farlio.cli_args import non_negative_float
 from farlio.datasets import FORMAT_HELP, FORMATS, LoadOptions, open_dataset
+from farlio.datasets.cut import StartCut
 from farlio.datasets.pointcloud2_encode import CONVENTIONS
 from farlio.ros2 import WAIT_SUBSCRIBERS_S, add_transport_argument, choose_transport, require_rclpy
 
@@ -48,6 +50,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="wait up to S seconds for a subscriber on every topic before playing (what is published "
         "before a subscriber is discovered is lost to it; 0: do not wait)",
     )
+    parser.add_argument(
+        "--start",
+        type=non_negative_float,
+        default=0.0,
+        metavar="S",
+        help="skip the recording's first S seconds (as farlio run --start): a node that starts while the vehicle "
+        "moves, or one restarted mid-run",
+    )
     parser.add_argument("--max-scans", type=int, default=None, help="stop after this many scans")
     parser.add_argument("--clock", action="store_true", help="also publish /clock at the IMU stamps (use_sim_time)")
     add_transport_argument(parser)
@@ -66,6 +76,8 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(f"--rate {args.rate}: expected > 0")
     options = LoadOptions(lidar_topics=list(args.in_lidar_topics), imu_topic=args.in_imu_topic, calib=args.calib)
     dataset = open_dataset(args.path, args.format, options)
+    if args.start > 0.0:
+        dataset = StartCut(dataset, args.start)
     stats = play(
         dataset,
         PlayOptions(

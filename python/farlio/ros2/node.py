@@ -212,6 +212,7 @@ class FarlioNode(Node):
     def _diagnostics(self, report: FrameReport) -> DiagnosticArray:
         f = report.frame
         r = f.scan
+        stats = self.live.odometry.fusion_stats
         status = DiagnosticStatus(name="farlio: scan", hardware_id=NODE_NAME)
         status.level = DiagnosticStatus.OK if f.processed and not f.drop_reason else DiagnosticStatus.WARN
         status.message = f.drop_reason or ("registered" if r.registered else "first scan: map started")
@@ -233,6 +234,8 @@ class FarlioNode(Node):
             "map_points": r.map_points,
             "guess_from_fusion": f.guess_from_fusion,
             "scans_dropped_busy": self.live.odometry.scans_dropped_busy,
+            # how the filter started (at rest or in motion), '' before
+            "fusion_initialization": stats.initialization.mode if stats is not None else "",
             **self.live.stats.as_dict(),
         }
         status.values = [KeyValue(key=k, value=str(v)) for k, v in values.items()]
