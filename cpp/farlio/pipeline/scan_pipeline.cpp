@@ -57,8 +57,8 @@ registration::Vec6d ScanPipeline::last_twist() const {
   return twist_between(prev_pose_, last_pose_, prev_stamp_ns_, last_stamp_ns_);
 }
 
-std::string ScanPipeline::register_frame(FrameResult& out, const SE3& guess, bool fused_guess,
-                                         std::size_t source_points, double time_budget_s) {
+std::string ScanPipeline::register_frame(FrameResult& out, bool fused_guess, std::size_t source_points,
+                                         double time_budget_s) {
   // the spacing as the backends' maps hold it (float)
   const auto spacing_m = static_cast<float>(map::point_spacing_m(config_.map));
   const double p2p =
@@ -74,7 +74,7 @@ std::string ScanPipeline::register_frame(FrameResult& out, const SE3& guess, boo
   if (fused_guess)
     thresholds.kernel_scale_m = std::min(thresholds.kernel_scale_m, config_.registration.fused_kernel_scale_m);
   out.kernel_scale_m = thresholds.kernel_scale_m;
-  out.registration = backend_->register_source(guess, thresholds, reg, time_budget_s);
+  out.registration = backend_->register_source(out.initial_guess, thresholds, reg, time_budget_s);
   out.registered = true;
   out.inlier_fraction = static_cast<double>(out.registration.system.inliers) / static_cast<double>(source_points);
   std::string failure = registration::failure_reason(out.registration, source_points, config_.registration);
@@ -183,7 +183,7 @@ FrameResult ScanPipeline::process(const Scan& input, const std::optional<SE3>& i
   SE3 pose = out.initial_guess;
   if (backend_->map_voxels() > 0 && source.points > 0) {
     const double time_budget_s = config_.registration.time_budget_factor * period_s;
-    out.failure = register_frame(out, out.initial_guess, fused_guess, source.points, time_budget_s);
+    out.failure = register_frame(out, fused_guess, source.points, time_budget_s);
     if (out.failure.empty()) {
       pose = out.registration.pose;
       threshold_.update(out.initial_guess.inverse() * pose);

@@ -105,11 +105,10 @@ class ScanPipeline {
   [[nodiscard]] registration::Vec6d last_twist() const;
 
  private:
-  /// GICP of the frame's source from `guess` at out.sigma_m (sets out.registration, registered,
-  /// inlier_fraction, kernel_scale_m); returns why its pose must not be used (empty when it may).
-  /// fused_guess: the guess is the fusion's.
-  std::string register_frame(FrameResult& out, const SE3& guess, bool fused_guess, std::size_t source_points,
-                             double time_budget_s);
+  /// GICP of the frame's source from out.initial_guess at out.sigma_m (sets out.registration,
+  /// registered, inlier_fraction, kernel_scale_m); returns why its pose must not be used (empty
+  /// when it may). fused_guess: the guess is the fusion's.
+  std::string register_frame(FrameResult& out, bool fused_guess, std::size_t source_points, double time_budget_s);
   /// Tracks failures in a row; after map_restart_after_s of them, empties the submap (a scan with
   /// points then starts it again) and returns true.
   bool restart_map_after_failures(std::int64_t stamp_ns, const FrameResult& result);
