@@ -192,7 +192,7 @@ inline constexpr double kMaxThreads = 1024.0;
         "position std at initialisation (the first LiDAR pose)")                                                      \
   FIELD(double, initial_attitude_std_rad, 0.02, range::positive_up_to(kMaxSiValue),                                   \
         "roll/pitch/yaw std at initialisation")                                                                       \
-  FIELD(double, init_window_s, 0.5, range::positive_up_to(kMaxDuration_s),                                            \
+  FIELD(double, init_window_s, 0.7, range::positive_up_to(kMaxDuration_s),                                            \
         "the filter starts from the LiDAR results of its first scans and the IMU between them: at rest from two, in " \
         "motion from those of this span (gravity in the map frame and the velocity, fusion/initialization.hpp)")      \
   FIELD(double, lidar_position_std_m, 0.05, range::positive_up_to(kMaxSiValue),                                       \
@@ -253,8 +253,8 @@ inline constexpr double kMaxThreads = 1024.0;
   FIELD(int, max_update_spread_steps, 20, range::between(1, kMaxCount), "cap of the automatic N")                     \
   FIELD(bool, standstill_bias, true, range::unchecked(),                                                              \
         "learn the gyro bias at standstill (the accelerometer bias stays at its initial value, as in the paper)")     \
-  FIELD(double, standstill_max_speed_m_s, 0.4, range::non_negative_up_to(kMaxSiValue),                                \
-        "standstill: estimated speed below this")                                                                     \
+  FIELD(double, standstill_max_speed_m_s, 0.1, range::non_negative_up_to(kMaxSiValue),                                \
+        "standstill: estimated speed below this (a walk's first steps are slower than 0.4 m/s)")                      \
   FIELD(double, standstill_max_gyro_rad_s, 0.05, range::non_negative_up_to(kMaxSiValue),                              \
         "standstill: |gyro| below this")                                                                              \
   FIELD(double, standstill_max_accel_deviation_m_s2, 1.0, range::non_negative_up_to(kMaxSiValue),                     \

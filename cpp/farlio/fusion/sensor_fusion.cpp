@@ -16,6 +16,9 @@ constexpr std::size_t kExtraHistoryEntries = 2;  ///< both ends of the history s
 /// In motion, the LiDAR results the alignment needs at least (two equations a pair, six unknowns
 /// a pose: three poses make it overdetermined).
 constexpr std::size_t kMinPosesInMotion = 3;
+/// The LiDAR poses of a body at rest move by up to this between two scans (registration noise):
+/// a window whose results move less shows rest whatever the scan rate.
+constexpr double kRestPositionJitter_m = 0.02;
 /// The zero-velocity prior of a window that shows the body at rest (m/s): tight, so that gravity
 /// follows from the specific force as in levelling.
 constexpr double kRestVelocityStd_m_s = 0.01;
@@ -284,7 +287,7 @@ bool SensorFusion::window_at_rest() const {
   for (std::size_t k = 1; k < window_.size(); ++k) {
     const double dt_s = ns_to_seconds(window_[k].stamp_ns - window_[k - 1].stamp_ns);
     const SE3 motion = window_[k - 1].body_pose.inverse() * window_[k].body_pose;
-    if (motion.translation().norm() > config_.standstill_max_speed_m_s * dt_s ||
+    if (motion.translation().norm() > std::max(config_.standstill_max_speed_m_s * dt_s, kRestPositionJitter_m) ||
         motion.angle_rad() > config_.standstill_max_gyro_rad_s * dt_s)
       return false;
   }
@@ -315,8 +318,9 @@ bool SensorFusion::initialize_from_window() {
   }
   const WindowPose& last = window_.back();
   const Eigen::Vector3d velocity_body = last.body_pose.rotation().transpose() * alignment->velocity_map_m_s;
-  // levelled at rest, gravity is off by the accelerometer's bias; in motion, by the alignment's error
-  const double levelled_tilt_std_rad = config_.accel_bias_std_m_s2 / gravity_m_s2_;
+  // levelled at rest, gravity is off by the accelerometer's bias (held, as the paper's 9-state
+  // filter holds its level, when the biases are not estimated); in motion, by the alignment's error
+  const double levelled_tilt_std_rad = config_.estimate_imu_bias ? config_.accel_bias_std_m_s2 / gravity_m_s2_ : 0.0;
   const double tilt_std_rad = first ? (at_rest ? levelled_tilt_std_rad : kInMotionTiltStd_rad) : known_tilt_std_rad_;
   initialize(last.stamp_ns, to_level(last.body_pose), velocity_body, config_.lidar_velocity_std_m_s, tilt_std_rad);
   InitializationReport& report = stats_.initialization;

@@ -126,8 +126,8 @@ class SensorFusion {
   void add_to_window(std::int64_t stamp_ns, const SE3& body_pose);
   /// Initialises the filter from the window when its results allow (initialization.hpp); true if it did.
   bool initialize_from_window();
-  /// Whether the window's results show the body at rest (standstill_max_speed_m_s and
-  /// standstill_max_gyro_rad_s between every two).
+  /// Whether the window's results show the body at rest (between every two, a displacement within
+  /// standstill_max_speed_m_s or the LiDAR's jitter, and a rotation within standstill_max_gyro_rad_s).
   [[nodiscard]] bool window_at_rest() const;
   /// The mean IMU input over [start_ns, end_ns] with the biases removed, for the alignment.
   [[nodiscard]] std::optional<ImuMean> imu_mean(std::int64_t start_ns, std::int64_t end_ns) const;
