@@ -6,6 +6,7 @@
 
 #include "farlio/fusion/euler.hpp"
 #include "farlio/fusion/kinematic_model.hpp"
+#include "farlio/fusion/measurement_model.hpp"
 #include "fusion_test_trajectory.hpp"
 
 using namespace farlio;
@@ -98,4 +99,37 @@ TEST(FusionModel, Rk4StepFollowsTheTruth) {
   const StateVector truth = true_state(traj, 1.0);
   EXPECT_LT((x - truth).head<3>().norm(), 1e-4);  // RK4 at 100 Hz on a 30 m/s curve: sub-mm
   EXPECT_LT((x - truth).segment<3>(kAttitudeIndex).norm(), 1e-6);
+}
+
+TEST(FusionModel, ReferenceAnglesAreRollAndPitchAgainstGravityThroughTheTilt) {
+  // what an accelerometer at rest measures (the specific force, up in the body frame) levels the
+  // body as the reference-angle model says, for any attitude and a tilted world frame
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> uni(-1.0, 1.0);
+  for (int c = 0; c < kRandomCases; ++c) {
+    StateVector x = StateVector::Zero();
+    x.segment<3>(kAttitudeIndex) = Eigen::Vector3d(0.5 * uni(rng), 0.5 * uni(rng), 3.0 * uni(rng));
+    x.segment<2>(kTiltIndex) = Eigen::Vector2d(0.1 * uni(rng), 0.1 * uni(rng));
+    const Eigen::Vector3d up_body =
+        -rotation_from_euler(x.segment<3>(kAttitudeIndex)).transpose() * world_gravity(x, test::kGravity_m_s2);
+    const double roll = std::atan2(up_body.y(), up_body.z());
+    const double pitch = std::atan2(-up_body.x(), std::hypot(up_body.y(), up_body.z()));
+    const Eigen::VectorXd h = measure(MeasurementKind::kRollPitch, x);
+    EXPECT_NEAR(h(0), roll, 1e-12) << "case " << c;
+    EXPECT_NEAR(h(1), pitch, 1e-12) << "case " << c;
+    // its Jacobian against central differences of the model over the attitude and the tilt
+    const Eigen::MatrixXd H = measurement_jacobian(MeasurementKind::kRollPitch, x);
+    for (const int i : {kAttitudeIndex, kAttitudeIndex + 1, kAttitudeIndex + 2, kTiltIndex, kTiltIndex + 1}) {
+      StateVector plus = x, minus = x;
+      plus(i) += 1e-5;
+      minus(i) -= 1e-5;
+      const Eigen::VectorXd d =
+          (measure(MeasurementKind::kRollPitch, plus) - measure(MeasurementKind::kRollPitch, minus)) / 2e-5;
+      EXPECT_LT((H.col(i) - d).cwiseAbs().maxCoeff(), 1e-6) << "case " << c << " state " << i;
+    }
+  }
+  // no tilt: the selector of roll and pitch
+  StateVector level = StateVector::Zero();
+  level.segment<3>(kAttitudeIndex) = Eigen::Vector3d(0.1, -0.2, 2.0);
+  EXPECT_EQ(measure(MeasurementKind::kRollPitch, level), level.segment<2>(kAttitudeIndex));
 }
