@@ -247,14 +247,17 @@ TEST(GyroUnit, DegreesPerSecondAreFoundBeforeTheFirstTurn) {
   }
 }
 
-TEST(GyroUnit, NoRotationAtAllDecidesNothing) {
-  // no rotation: the gyro's noise and bias (57 times larger in deg/s) say nothing of its unit
+TEST(GyroUnit, WithoutRotationTheNoiseTellsRadPerSecondAndNothingElse) {
+  // no rotation at all: a MEMS gyro's noise (0.003 rad/s a sample) is rad/s; the same gyro in deg/s
+  // (0.17 a sample) and a vibrating one in rad/s (0.05 a sample) decide nothing
   for (unsigned seed = 1; seed <= 5; ++seed) {
-    for (const double unit : {1.0, kDegPerRad}) {
-      fusion::GyroUnitDetector d(true, 0.1, 0.05);
-      drive_straight(d, 30.0, 0.0, unit, 0.01, 0.003, 2e-4, seed);
-      EXPECT_FALSE(d.decided()) << unit << " seed " << seed;
-    }
+    fusion::GyroUnitDetector rad(true, 0.1, 0.05), deg(true, 0.1, 0.05), shaken(true, 0.1, 0.05);
+    EXPECT_LT(drive_straight(rad, 30.0, 0.0, 1.0, 0.01, 0.003, 2e-4, seed), 2.0) << seed;
+    EXPECT_EQ(rad.unit(), fusion::GyroUnit::kRadPerSecond) << seed;
+    drive_straight(deg, 30.0, 0.0, kDegPerRad, 0.01, 0.003, 2e-4, seed);
+    EXPECT_FALSE(deg.decided()) << seed;
+    drive_straight(shaken, 30.0, 0.0, 1.0, 0.01, 0.05, 2e-4, seed);
+    EXPECT_FALSE(shaken.decided()) << seed;
   }
 }
 

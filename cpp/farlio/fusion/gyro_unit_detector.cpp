@@ -20,6 +20,10 @@ constexpr int kMinRegressionIntervals = 8;
 /// Beyond their standard error, the slope may miss its unit's value by this much (the gyro's
 /// scale factor, the LiDAR's and the IMU's timing).
 constexpr double kSlopeTolerance = 0.2;
+/// The gyro's spread (per axis, in its unit) while the LiDAR does not turn, below which it reports
+/// rad/s, and the samples that takes (see the header).
+constexpr double kMaxQuietSpread = 0.02;
+constexpr double kMinQuietSamples = 100.0;
 
 std::string number(double v) {
   char buf[32];
@@ -45,12 +49,35 @@ void GyroUnitDetector::add_imu(const ImuSample& s) {
     integrals_.push_back({s.stamp_ns, integrals_.back().angle + 0.5 * dt * (s.gyro_rad_s + last_->gyro_rad_s)});
   }
   last_ = s;
+  samples_.push_back(s);
   while (integrals_.size() > 2 && integrals_[1].stamp_ns < s.stamp_ns - seconds_to_ns(kKeptIntegral_s)) {
     integrals_.pop_front();
   }
+  while (samples_.front().stamp_ns < s.stamp_ns - seconds_to_ns(kKeptIntegral_s)) samples_.pop_front();
 }
 
-void GyroUnitDetector::forget_samples() { integrals_.clear(); }
+void GyroUnitDetector::forget_samples() {
+  integrals_.clear();
+  samples_.clear();
+}
+
+void GyroUnitDetector::add_quiet_interval(std::int64_t start_ns, std::int64_t end_ns) {
+  for (const ImuSample& s : samples_) {
+    if (s.stamp_ns <= start_ns || s.stamp_ns > end_ns) continue;
+    quiet_count_ += 1.0;
+    quiet_sum_ += s.gyro_rad_s;
+    quiet_sum_sq_ += s.gyro_rad_s.cwiseAbs2();
+  }
+  if (quiet_count_ < kMinQuietSamples) return;
+  const Eigen::Vector3d mean = quiet_sum_ / quiet_count_;
+  const Eigen::Vector3d spread = (quiet_sum_sq_ / quiet_count_ - mean.cwiseAbs2()).cwiseMax(0.0).cwiseSqrt();
+  // a reading that never changes is a stuck gyro, not a quiet one
+  if (gyro_changed_ && spread.maxCoeff() < kMaxQuietSpread) {
+    unit_ = GyroUnit::kRadPerSecond;
+    integrals_.clear();
+    samples_.clear();
+  }
+}
 
 std::optional<Eigen::Vector3d> GyroUnitDetector::integral_at(std::int64_t t) const {
   if (integrals_.empty() || t < integrals_.front().stamp_ns || t > integrals_.back().stamp_ns) return std::nullopt;
@@ -125,7 +152,10 @@ void GyroUnitDetector::add_lidar_rotation(std::int64_t start_ns, std::int64_t en
   regress(*b - *a, lidar_rotation, dt_s);
   if (decided()) return;
   const double gyro = (*b - *a).norm(), lidar_angle_rad = lidar_rotation.norm();
-  if (lidar_angle_rad < min_rate_rad_s_ * dt_s) return;
+  if (lidar_angle_rad < min_rate_rad_s_ * dt_s) {
+    add_quiet_interval(start_ns, end_ns);
+    return;
+  }
   gyro_sum_rad_ += gyro;
   lidar_sum_rad_ += lidar_angle_rad;
   ++intervals_;

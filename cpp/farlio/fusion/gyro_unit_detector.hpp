@@ -14,6 +14,11 @@
 //   come out near 1 (rad/s) or near pi/180 (deg/s) well before the first turn; k is taken once its
 //   interval of several standard errors lies above zero (the LiDAR follows the gyro: the gyro's
 //   readings are not its noise alone) and around one unit's value.
+//   Noise while the LiDAR does not turn: the gyro's readings spread by its noise about its bias.
+//   A spread below kMaxQuietSpread (0.02 in the gyro's unit) over kMinQuietSamples samples is a
+//   rad/s gyro: in deg/s it would be 3.5e-4 rad/s a sample, a navigation-grade gyro's, where a
+//   MEMS gyro spreads by 1e-3..1e-2 rad/s (0.06..0.6 deg/s). A larger spread (vibration, a
+//   deg/s gyro) decides nothing.
 // The detector also tells whether a scan's gyro rotation is large enough that, while the unit is
 // undecided, the fusion's guess (which a deg/s gyro would ruin) should not be used for it.
 #include <Eigen/Core>
@@ -72,6 +77,9 @@ class GyroUnitDetector {
   bool gyro_changed_ = false;
   /// The regression of the LiDAR's rotations on the gyro's: decides when k is clear.
   void regress(const Eigen::Vector3d& gyro, const Eigen::Vector3d& lidar, double dt_s);
+  /// The gyro's samples over an interval in which the LiDAR did not turn: decides rad/s when they
+  /// spread by a MEMS gyro's noise in rad/s.
+  void add_quiet_interval(std::int64_t start_ns, std::int64_t end_ns);
 
   double gyro_sum_rad_ = 0.0, lidar_sum_rad_ = 0.0;
   int intervals_ = 0;
@@ -80,6 +88,10 @@ class GyroUnitDetector {
   Eigen::Vector3d s_gt_ = Eigen::Vector3d::Zero(), s_lt_ = Eigen::Vector3d::Zero();
   int regression_intervals_ = 0;
   double slope_ = 0.0, slope_std_ = 0.0;  ///< k and its standard error when it decided
+  std::deque<ImuSample> samples_;         ///< raw, the last kKeptIntegral_s, for the quiet intervals
+  // the samples of the quiet intervals: count, sum, sum of squares (per axis)
+  double quiet_count_ = 0.0;
+  Eigen::Vector3d quiet_sum_ = Eigen::Vector3d::Zero(), quiet_sum_sq_ = Eigen::Vector3d::Zero();
 };
 
 /// Mean |accel| below this (in m/s^2 or in g) is no accelerometer at all: it reads zero.
