@@ -460,9 +460,8 @@ void push_in_order(OnlineOdometry& online, const Recording& rec, Sample&& sample
 }  // namespace
 
 TEST(OnlineClocks, OneFarFutureImuStampCostsOneSample) {
-  // a single sample stamped 10,000 s ahead: once that reset the fusion twice (ahead and back)
-  // and, in a file, dropped every later sample; now that one sample is dropped and the run is
-  // the run without it
+  // a single sample stamped 10,000 s ahead: that one sample is dropped (not the fusion reset twice,
+  // ahead and back, nor every later sample dropped) and the run is the run without it
   const Recording& rec = urban();
   constexpr std::int64_t kJumpNs = 10'000LL * kNsPerSecond;
   const std::size_t bad = rec.imu.size() / 2;
