@@ -25,6 +25,16 @@ void bind_sim(nb::module_& m) {
       .value("Tunnel", Profile::Tunnel);
   m.def("parse_profile", &parse_profile, "name"_a, "'racetrack' | 'urban' | 'handheld' | 'tunnel'.");
   m.def("profile_name", &profile_name, "profile"_a);
+  nb::enum_<LidarModel>(m, "LidarModel")
+      .value("Profile", LidarModel::Profile)
+      .value("Avia", LidarModel::Avia)
+      .value("Mid360", LidarModel::Mid360)
+      .value("Vlp16", LidarModel::Vlp16)
+      .value("Hdl32", LidarModel::Hdl32)
+      .value("Os128", LidarModel::Os128);
+  m.def("parse_lidar_model", &parse_lidar_model, "name"_a,
+        "'profile' | 'avia' | 'mid360' | 'vlp16' | 'hdl32' | 'os128' (docs/simulation.md, 'LiDAR models').");
+  m.def("lidar_model_name", &lidar_model_name, "model"_a);
 
   nb::class_<NoiseConfig>(m, "NoiseConfig", "LiDAR and IMU noise of a simulated sequence.")
       .def(nb::init<>())
@@ -88,6 +98,8 @@ void bind_sim(nb::module_& m) {
       .def_rw("start_stamp_ns", &SimConfig::start_stamp_ns)
       .def_rw("motion_start_s", &SimConfig::motion_start_s,
               "t = 0 of the sequence is this instant of the profile's motion (s; 0: at its start, at rest)")
+      .def_rw("lidar_model", &SimConfig::lidar_model,
+              "the LiDAR on the vehicle: the profile's own sensors (Profile) or one sensor of a named model")
       .def_rw("lidar_rate_hz", &SimConfig::lidar_rate_hz)
       .def_rw("imu_rate_hz", &SimConfig::imu_rate_hz)
       .def_rw("gravity_m_s2", &SimConfig::gravity_m_s2);

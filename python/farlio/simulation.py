@@ -20,6 +20,9 @@ GROUNDTRUTH_RATE_HZ = 100.0
 
 #: IMU grades (docs/simulation.md): the profile's own IMU noise (default), an ideal IMU, datasheet classes
 IMU_GRADES = ("profile", "ideal", "consumer", "industrial", "tactical")
+#: LiDAR models (docs/simulation.md): the profile's own sensors (default), Livox's non-repetitive
+#: Avia and Mid-360, spinning heads of 16, 32 and 128 beams
+LIDAR_MODELS = ("profile", "avia", "mid360", "vlp16", "hdl32", "os128")
 
 
 def make_config(
@@ -31,18 +34,28 @@ def make_config(
     noise_free: bool = False,
     imu_grade: str = "profile",
     vibration: bool = True,
+    lidar: str = "profile",
+    lidar_rate_hz: float | None = None,
+    imu_rate_hz: float | None = None,
     **noise: float,
 ) -> Any:
     """The profile's defaults with the given overrides: the IMU set to imu_grade (with the platform
     vibration of the datasheet grades unless vibration=False), then the noise fields by their
     NoiseConfig name. motion_start_s > 0 begins the sequence that far into the profile's motion (a
-    recording that starts while the body moves)."""
+    recording that starts while the body moves). lidar puts one sensor of a named model (LIDAR_MODELS)
+    on the vehicle in place of the profile's own; lidar_rate_hz and imu_rate_hz replace the profile's
+    rates."""
     cfg = _core.sim.default_config(profile)
     cfg.seed = seed
     if duration_s is not None:
         cfg.duration_s = duration_s
     cfg.motion_start_s = motion_start_s
     cfg.noise_free = noise_free
+    cfg.lidar_model = _core.sim.parse_lidar_model(lidar)
+    if lidar_rate_hz is not None:
+        cfg.lidar_rate_hz = lidar_rate_hz
+    if imu_rate_hz is not None:
+        cfg.imu_rate_hz = imu_rate_hz
     cfg = _core.sim.apply_imu_grade(cfg, imu_grade, vibration)
     n = cfg.noise
     for name, value in noise.items():

@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <string>
 
+#include "farlio/sim/lidar_model.hpp"
+
 namespace farlio::sim {
 
 enum class Profile { Racetrack, Urban, Handheld, Tunnel };
@@ -71,6 +73,9 @@ struct SimConfig {
   /// instant of the motion. 0 (the default): at the profile's start, at rest; later: a recording
   /// that begins while the body already moves (a cut bag, a node restarted at speed).
   double motion_start_s = 0.0;
+  /// The LiDAR on the vehicle: the profile's own sensors (Profile, the default) or one sensor of a
+  /// named model in their place, mounted where the profile's first sensor is (lidar_model.hpp).
+  LidarModel lidar_model = LidarModel::Profile;
   double lidar_rate_hz = 0.0;
   double imu_rate_hz = 0.0;
   double gravity_m_s2 = 0.0;

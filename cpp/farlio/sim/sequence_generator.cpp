@@ -23,7 +23,17 @@ constexpr std::size_t kColumnsPerTask = 16;
 /// Sampling rate of the trajectory statistics in description().
 constexpr double kStatsRate_hz = 50.0;
 
-struct Firing {  // one column of one sensor
+/// The profile's world with the configured LiDAR model in place of the profile's sensors.
+World world_for(const SimConfig& config) {
+  World w = build_world(config.profile);
+  if (config.lidar_model == LidarModel::Profile) return w;
+  const SE3 mount = w.lidars.front().T_lidar_sensor;
+  w.lidars = {lidar_model(config.lidar_model, 0, mount, config.lidar_rate_hz)};
+  w.facts["lidar"] = lidar_model_name(config.lidar_model);
+  return w;
+}
+
+struct Firing {  // one firing of one sensor
   double time_fraction;
   std::uint8_t sensor;
   int column;
@@ -72,10 +82,10 @@ class LaterStart final : public MotionModel {
 };
 }  // namespace
 
-SequenceGenerator::SequenceGenerator(const SimConfig& config)
-    : config_(config), world_(std::make_shared<const World>(build_world(config.profile))) {
+SequenceGenerator::SequenceGenerator(const SimConfig& config) : config_(config) {
   if (!(config_.lidar_rate_hz > 0.0) || !(config_.imu_rate_hz > 0.0) || !(config_.duration_s > 0.0))
     throw std::invalid_argument("SimConfig: lidar_rate_hz, imu_rate_hz and duration_s must be positive");
+  world_ = std::make_shared<const World>(world_for(config_));
   if (!(config_.motion_start_s >= 0.0) || !std::isfinite(config_.motion_start_s))
     throw std::invalid_argument("SimConfig: motion_start_s must be finite and not negative");
   motion_ = config_.motion_start_s > 0.0 ? std::make_shared<const LaterStart>(world_->motion, config_.motion_start_s)
@@ -112,7 +122,7 @@ Scan SequenceGenerator::scan(std::size_t i) const {
   std::size_t num_rays = 0;
   for (auto& f : firings) {
     f.first_ray = num_rays;
-    num_rays += lidars[f.sensor].elevations_rad.size();
+    num_rays += lidars[f.sensor].num_channels();
   }
 
   Scan out;
@@ -135,11 +145,11 @@ Scan SequenceGenerator::scan(std::size_t i) const {
       const SE3 T_world_sensor = T_world_lidar * l.T_lidar_sensor;
       const Eigen::Vector3d origin = T_world_sensor.translation();
       const Mat3d R_world_sensor = T_world_sensor.rotation();
-      for (std::size_t ch = 0; ch < l.elevations_rad.size(); ++ch) {
+      for (std::size_t ch = 0; ch < l.num_channels(); ++ch) {
         const std::size_t ray = firing.first_ray + ch;
         if (!config_.noise_free && uniform01(config_.seed, Stream::LidarDropout, i, ray) < noise.dropout_probability)
           continue;
-        const Eigen::Vector3d dir_sensor = l.direction(firing.column, ch);
+        const Eigen::Vector3d dir_sensor = l.direction(firing.column, ch, i);
         const Eigen::Vector3d dir_world = R_world_sensor * dir_sensor;
         const auto hit = world_->scene.cast(origin, dir_world, l.max_range_m);
         if (!hit) continue;
@@ -224,6 +234,7 @@ std::map<std::string, std::string> SequenceGenerator::description() const {
   d["duration_s"] = num(config_.duration_s);
   d["motion_start_s"] = num(config_.motion_start_s);  // t = 0 is this instant of the profile's motion
   d["noise_free"] = config_.noise_free ? "true" : "false";
+  d["lidar_model"] = lidar_model_name(config_.lidar_model);
   d["lidar_rate_hz"] = num(config_.lidar_rate_hz);
   d["imu_rate_hz"] = num(config_.imu_rate_hz);
   d["gravity_m_s2"] = num(config_.gravity_m_s2);

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from farlio.cli_args import non_negative_float, non_negative_int, positive_float, probability
 from farlio.progress import Progress
-from farlio.simulation import IMU_GRADES, PROFILES, make_config, write_sequence
+from farlio.simulation import IMU_GRADES, LIDAR_MODELS, PROFILES, make_config, write_sequence
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -36,6 +36,29 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="S",
         help="begin the sequence S seconds into the profile's motion (default 0: at its start, at rest); later "
         "starts record a body already moving, as a cut recording or a node restarted at speed does",
+    )
+    parser.add_argument(
+        "--lidar",
+        choices=LIDAR_MODELS,
+        default="profile",
+        help="profile: the profile's own LiDARs (default); one sensor of a model in their place, where the "
+        "first one is mounted: avia (Livox Avia class, forward 70x77 deg non-repetitive rosette, 240k points/s), "
+        "mid360 (Livox Mid-360 class, 360x59 deg non-repetitive, 200k points/s), vlp16, hdl32, os128 (spinning "
+        "16, 32, 128 beams) (docs/simulation.md)",
+    )
+    parser.add_argument(
+        "--lidar-rate",
+        type=positive_float,
+        default=None,
+        metavar="HZ",
+        help="scans per second (default: the profile's)",
+    )
+    parser.add_argument(
+        "--imu-rate",
+        type=positive_float,
+        default=None,
+        metavar="HZ",
+        help="IMU samples per second (default: the profile's; 10 Hz is KITTI raw's OXTS rate)",
     )
     parser.add_argument("--noise-free", action="store_true", help="exact ranges, no dropout, IMU without noise/bias")
     parser.add_argument(
@@ -81,6 +104,9 @@ def run(args: argparse.Namespace) -> int:
         noise_free=args.noise_free,
         imu_grade=args.imu_grade,
         vibration=not args.no_vibration,
+        lidar=args.lidar,
+        lidar_rate_hz=args.lidar_rate,
+        imu_rate_hz=args.imu_rate,
         range_noise_std_m=args.range_noise,
         dropout_probability=args.dropout,
         gyro_noise_std_rad_s=args.gyro_noise,
