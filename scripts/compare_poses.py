@@ -2,7 +2,7 @@
 """Whether two builds give the same poses: each build (a directory holding a `farlio` package, put
 first on PYTHONPATH in a process of its own) runs the LiDAR-only scan pipeline over the real KITTI
 scans and generated urban scans; the largest difference between their pose matrices is printed
-(0 when a change kept every float, as docs/performance.md's stop 28 reports).
+(0 when a change kept every float).
 
     python scripts/compare_poses.py --build before=DIR --build after=.venv/lib/python3.11/site-packages
         [--data ../shared/data/real/kitti_16_scans] [--urban-scans 40] [--threads 2]

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Per run, what the registration's thresholds saw, from the timing.csv of `farlio run`: the
-adaptive sigma and the Cauchy kernel scale used (docs/fusion.md, stop 26: the kernel with the
+adaptive sigma and the Cauchy kernel scale used (docs/fusion.md: the kernel with the
 fusion's guess), and the degeneracy statistics (the largest translation std, the largest std per
 matched point = translation_std_max_m * sqrt(inliers), the largest rotation std, the flagged scans,
 and the per-point std of the scans whose std exceeds --bare-std-m: the tunnel's bare section).

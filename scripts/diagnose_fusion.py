@@ -6,7 +6,7 @@ against the exact ground truth, next to LiDAR-only on the same data (docs/fusion
 Each variant isolates one part of the fusion:
   lidar_only      no fusion (the reference the LIO must not be worse than)
   lio             the defaults
-  paper_filter    the filter before issue 11: no bias states, the fixed LiDAR noise (the other
+  paper_filter    the paper's filter: no bias states, the fixed LiDAR noise (the other
                   variants run on it with --set fusion.estimate_imu_bias=false
                   fusion.lidar_information_from_registration=false)
   ideal_imu       the same scans, the IMU of the noise-free generator (no noise, no bias)
@@ -53,7 +53,7 @@ from farlio.simulation import generate
 LINE_MIN_SPREAD_TO_RESIDUAL = 1000.0
 FIXED_LATENCY_S = 0.02  # the accuracy tables' latency model (scripts/measure_accuracy.py)
 
-# the filter before issue 11: no bias states, the fixed LiDAR noise
+# the paper's filter: no bias states, the fixed LiDAR noise
 PAPER_FILTER = {"fusion.estimate_imu_bias": "false", "fusion.lidar_information_from_registration": "false"}
 VARIANTS: dict[str, tuple[dict[str, str], str]] = {
     # name: (config overrides, IMU source)

@@ -2,7 +2,7 @@
 """The largest frames of one LiDAR-only run, from the stage times the pipeline measures itself
 (`FrameResult.timings`), without the rest of `farlio bench` in the process (no KISS-ICP, no
 yardsticks): the median and p99 of the whole frame and, per largest frame, its stages
-(docs/performance.md, stop 27: the first frame builds the submap and is the largest).
+(docs/performance.md: the first frame builds the submap and is the largest).
 
     python scripts/frame_times.py --profile urban --scans 100 --threads 2 [--data DIR] [--top 8] [--repeat N]
 

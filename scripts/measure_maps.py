@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Maps (issue 15): map a generated sequence once, then run a second pass over the same scene (other
+"""Maps: map a generated sequence once, then run a second pass over the same scene (other
 noise seeds) twice, as odometry and localized in the saved map (`--prior-map`), with the same code
 path as `farlio run` (run_dataset) on scans generated in memory (no sequence on disk: a racetrack
 lap is ~7 GB of PCD). Prints per profile and pass seed:

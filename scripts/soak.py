@@ -59,9 +59,7 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--online", action="store_true", help="OnlineOdometry instead of the replay")
     ap.add_argument("--no-map", action="store_true", help="without the whole map (the odometry's memory alone)")
-    ap.add_argument(
-        "--no-spill", action="store_true", help="the whole map all in memory (no tiles on disk, as before issue 15)"
-    )
+    ap.add_argument("--no-spill", action="store_true", help="the whole map all in memory (no tiles on disk)")
     args = ap.parse_args()
     cfg = _core.sim.default_config(args.profile)
     cfg.seed = args.seed

@@ -1,5 +1,5 @@
 // Sizes announced by a file that overflow or exceed their limit: each case once crashed, hung
-// or misread a reader (issue 13). Crafted bytes are written to a file and read back through
+// or misread a reader. Crafted bytes are written to a file and read back through
 // read_point_cloud, as a user's file would be.
 #include <gtest/gtest.h>
 

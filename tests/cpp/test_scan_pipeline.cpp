@@ -123,9 +123,9 @@ Scan scan_with_points(int k, double period_s, std::vector<Eigen::Vector3f> point
 
 }  // namespace
 
-// Issue 13 item 6 / issue 11 item 4: a scan of 3 points or of one point repeated "converged" with
-// a single inlier and moved the pose by metres; now it fails, keeps the prediction and changes
-// neither the map nor the adaptive threshold, and the next good scan registers as before.
+// A scan of 3 points, or of one point repeated, could "converge" with a single inlier and move the
+// pose by metres: it fails, keeps the prediction and changes neither the map nor the adaptive
+// threshold, and the next good scan registers as before.
 TEST(ScanPipeline, ADegenerateScanFailsKeepsThePredictionAndChangesNothing) {
   const double period = 0.1;
   Config cfg;

@@ -1,4 +1,4 @@
-"""The fusion must never make the odometry worse (issue 11): on generated sequences of every
+"""The fusion must never make the odometry worse: on generated sequences of every
 profile and on seeds other than the one the other tests use, the LIO's scan poses are at least as
 accurate as LiDAR-only on the same data, in APE, rotation RMSE and KITTI-style RPE (fixed 20 ms
 latency). Measured with scripts/diagnose_fusion.py, docs/fusion.md "Never worse"."""
@@ -22,7 +22,7 @@ MARGIN = 1.05
 # racetrack and on handheld it is clearly smaller.
 ROTATION_SLACK_DEG = 0.01
 # The 30 s racetrack (1.4 km, 0 -> 250 km/h) on the two seeds where the LIO was worse than
-# LiDAR-only before the kernel cap (registration.fused_kernel_scale_m; docs/fusion.md, stop 26):
+# LiDAR-only before the kernel cap (registration.fused_kernel_scale_m; docs/fusion.md):
 # strictly no worse, no margin.
 RACETRACK_30S_SEEDS = [3, 4]
 

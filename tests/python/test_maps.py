@@ -1,4 +1,4 @@
-"""Maps (issue 15): the whole map of a run (--save-map) lies on the generator's surfaces, and a
+"""Maps: the whole map of a run (--save-map) lies on the generator's surfaces, and a
 second pass over the same scene (another noise seed) localized in it (--prior-map) follows the map
 without drift, while its own odometry drifts away from it; a wrong initial pose is reported as not
 localized."""

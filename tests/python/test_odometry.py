@@ -22,7 +22,7 @@ from farlio.simulation import generate
 # APE bound m). Measured with a fixed 20 ms latency (seed 1), bounds ~3x above:
 #   urban 10 s     LIO: APE 0.006 m, RPE 0.05 %, odometry APE 0.007 m; LiDAR-only: 0.008 m, 0.07 %
 #   handheld 25 s  LIO: APE 0.009 m, RPE 0.14 %, odometry APE 0.012 m; LiDAR-only: 0.092 m, 1.9 %
-#   (these two: scripts/measure_accuracy.py, stop 26)
+#   (these two: scripts/measure_accuracy.py)
 #   racetrack 6 s  LIO: APE 0.034 m, RPE 0.20 %, odometry APE 0.038 m; LiDAR-only: 0.051 m, 0.35 %
 #                  (standing start, launch to 12 m/s: the case of docs/odometry.md "racetrack launch")
 # (LiDAR-only suffers from the 3 rad/s head turns under its constant-velocity model.)

@@ -1,4 +1,4 @@
-"""Randomised mutation of PointCloud2-like messages (issue 13): the PointCloud2 decoder is Python
+"""Randomised mutation of PointCloud2-like messages: the PointCloud2 decoder is Python
 and numpy, so instead of a libFuzzer target it gets this property test. Valid messages of the
 drivers' layouts (pointcloud2_encode) are mutated at random: width, height, point_step, row_step,
 field offsets, datatypes, counts and names, endianness, stamps, and the data cut, extended or

@@ -1,4 +1,4 @@
-"""Recovery from faults (issue 11 item 4, issue 13 items 4 and 6): scans that carry nothing (2 s of
+"""Recovery from faults: scans that carry nothing (2 s of
 empty scans at speed), a bogus scan, and corrupt IMU samples. The run must go on, write no NaN and
 no wild jump, report what happened (timing.csv drop_reason, summary.json), and stay close to the
 accuracy of the clean run on the same sequence."""

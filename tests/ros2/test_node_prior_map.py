@@ -1,4 +1,4 @@
-"""`farlio ros2` with `prior_map` and `initial_pose` (issue 15): the node localizes the played
+"""`farlio ros2` with `prior_map` and `initial_pose`: the node localizes the played
 sequence in the map `farlio run --save-map` made of it, starting 0.3 m / 1 deg off; every scan
 matches the map (diagnostics `lost` False, `inlier_fraction` high) and the scan odometry is where
 the mapping run put each scan."""

@@ -20,7 +20,7 @@ from farlio.evaluation import evaluate_files  # noqa: E402
 from farlio.runner import ODOMETRY_TUM, run_dataset  # noqa: E402
 from loopback import play, wait_for_diagnostics  # noqa: E402
 
-#: the live odometry may be this much worse than the replay of `farlio run` (issue 12)
+#: the live odometry may be this much worse than the replay of `farlio run`
 ACCURACY_FACTOR = 1.5
 #: RPE over pairs this far apart along the ground truth
 RPE_DELTA_M = 1.0

@@ -140,7 +140,7 @@ inline constexpr double kMaxThreads = 1024.0;
         "LIO: the Cauchy kernel scale is at most this when the initial guess is the fusion's prediction. "        \
         "KISS-ICP's sigma / 3 measures a constant-velocity guess; the IMU's guess deviates less than "            \
         "threshold.min_motion_m, so sigma keeps its initial value and sigma / 3 lets wrong matches pull "         \
-        "(docs/fusion.md, stop 26); LiDAR-only keeps sigma / 3, which its standing start needs")                  \
+        "(docs/fusion.md); LiDAR-only keeps sigma / 3, which its standing start needs")                           \
   FIELD(double, damping, 1e-9, range::non_negative_up_to(kMaxRatio), "lambda added to the diagonal of H")         \
   FIELD(double, covariance_scale, 0.05, range::positive_up_to(kMaxRatio),                                         \
         "pose covariance = covariance_scale * H^-1 (H in the factors' normalised units; docs/fusion.md measures " \

@@ -62,8 +62,8 @@ FARLIO_HD inline float float_from_bits(std::uint32_t b) {
 /// log(1 + x) for x >= 0 (the Cauchy kernel's cost), within 3e-7 of the exact value relative
 /// (2 to 3 float ulps; tests/cpp/test_shared_bodies.cpp): 1 + x = 2^e m with m in [sqrt(1/2), sqrt(2)), log m =
 /// 2 atanh((m - 1) / (m + 1)) by its series, and the rounding of 1 + x corrected to first order.
-/// glibc's log1pf saves and restores the floating-point environment on every call, which made it
-/// a twentieth of a frame's registration (stop 27). Infinity and NaN come back as they are.
+/// glibc's log1pf saves and restores the floating-point environment on every call, which would make
+/// it a twentieth of a frame's registration. Infinity and NaN come back as they are.
 FARLIO_HD inline float log1p_nonnegative(float x) {
   if (!(x < 3.0e38f)) return x;
   constexpr float kLn2 = 0.693147180559945f, kSqrt2 = 1.41421356f;

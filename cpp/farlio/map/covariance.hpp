@@ -65,7 +65,7 @@ struct CovarianceAccumulator {
 /// characteristic cubic gives the smallest as q - 2 p cos(u) with cos(3u) = -r; c = cos(u) in
 /// [1/2, 1] is written 1/2 + s, and s solves 4 s^3 + 6 s^2 = 1 - r, which Newton's method reaches
 /// in two steps from a close start (the cubic is convex for s >= 0). acosf and two cosf cost
-/// more than the rest of the shape test (stop 27, BM_CovarianceKnn).
+/// more than the rest of the shape test (BM_CovarianceKnn).
 FARLIO_HD inline Eigen::Vector3f symmetric_eigenvalues(const Eigen::Matrix3f& a) {
   const float off2 = a(0, 1) * a(0, 1) + a(0, 2) * a(0, 2) + a(1, 2) * a(1, 2);
   const float q = a.trace() / 3.0f;

@@ -45,7 +45,7 @@ inline constexpr int kCentreCode = 13;
 /// The block position of the n-th voxel around a centre (n = 0 is the centre, the rest in a
 /// fixed order): axis a is offset by digit a of the code in base 3, minus 1. The searches visit
 /// them in a per-query order (for_each_block_neighbor_near_first); all faces, then edges, then
-/// corners was not faster (BM_NearestNeighbor, BM_CovarianceKnn, stop 27).
+/// corners is not faster (BM_NearestNeighbor, BM_CovarianceKnn).
 FARLIO_HD inline int neighbor_code(int n) { return n == 0 ? kCentreCode : (n <= kCentreCode ? n - 1 : n); }
 
 /// The n-th voxel of the block around c0.
@@ -98,7 +98,7 @@ struct BlockDistances {
 /// voxel away), so a search's bound tightens before the far voxels, which it then mostly skips:
 /// when bound2() is within the nearest far side, none of the 19 is visited. A covariance query
 /// of the urban scan compares 40.5 points instead of 45.4 in the order of neighbor_code
-/// (bench_kernels' BM_CovarianceKnn counters, stop 28).
+/// (bench_kernels' BM_CovarianceKnn counters).
 template <typename Bound, typename F>
 FARLIO_HD void for_each_block_neighbor_near_first(const BlockDistances& box, const Bound& bound2, const F& f) {
   const auto code = [](int x, int y, int z) { return x + 3 * y + 9 * z; };
@@ -206,7 +206,7 @@ FARLIO_HD inline std::int64_t nearest_neighbor(const ConstMapView& m, const Eige
 /// Bits of a candidate's visit position within its k-NN key: the point's slot in its voxel
 /// (below 1024), above it the voxel's rank in the walk (below 27). The block loop over a voxel's
 /// points is written out here and in nearest_neighbor: a shared helper taking the per-block
-/// lambda made the covariance stage's k-NN 14 % slower (BM_CovarianceKnn, stop 23).
+/// lambda makes the covariance stage's k-NN 14 % slower (BM_CovarianceKnn).
 inline constexpr int kSlotBits = 10;
 static_assert(kMaxPointsPerVoxel < (1 << kSlotBits) && kNeighborVoxels < (1 << (32 - kSlotBits)),
               "a k-NN key's visit position holds a voxel's slot and the voxel's rank in the walk");
@@ -219,7 +219,7 @@ inline constexpr int kRankedVoxelPoints = 32;
 /// ranked by counting the points before it in (distance, slot) order, four comparisons at a
 /// time, and the k first go to their places in `best` (the others to best[kMaxNeighbors], a
 /// scratch slot). The same list as inserting them one by one, without the insertions' branches,
-/// which depend on the distances (most of the k-NN's time: docs/performance.md, stop 27).
+/// which depend on the distances (most of the k-NN's time: docs/performance.md).
 /// Returns how many are in the list.
 inline int rank_first_voxel(const ConstMapView& m, std::int64_t first, std::int32_t n, const Eigen::Vector3f& query,
                             int k, float bound, std::uint64_t* best) {

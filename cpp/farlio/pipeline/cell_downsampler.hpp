@@ -55,7 +55,7 @@ class CellDownsampler {
     // each block into its own table, its cells then sorted by key (a task per block, one
     // thread each). Block b takes the chunks b, b + blocks, b + 2 blocks, ... of the scan: parts
     // of a scan differ in cost (far rings put each point in a new cell), and contiguous halves
-    // left one thread waiting for the other (KITTI: 757 against 457 us, stop 27)
+    // would leave one thread waiting for the other (KITTI: 757 against 457 us)
     const std::size_t chunks = (n + kChunkPoints - 1) / kChunkPoints;
     executor.for_each(
         blocks,

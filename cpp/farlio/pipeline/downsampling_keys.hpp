@@ -2,7 +2,7 @@
 // The CPU's batch of downsampling_key (preprocess_point.hpp): the same keys, computed four points
 // at a time with SSE2 (x86-64's baseline) where the host has it, point by point otherwise. The
 // keys were three quarters of the preprocessing's loop, most of it the three floors per point
-// (docs/performance.md, stop 27). CUDA runs downsampling_key itself, one thread a point;
+// (docs/performance.md). CUDA runs downsampling_key itself, one thread a point;
 // tests/cpp/test_shared_bodies.cpp checks that both give the same keys, bit for bit.
 #include <cstddef>
 #include <cstdint>

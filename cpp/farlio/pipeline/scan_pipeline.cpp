@@ -65,7 +65,7 @@ std::string ScanPipeline::register_frame(FrameResult& out, bool fused_guess, std
       registration::point_to_point_precision(config_.registration, config_.map.covariance_epsilon, spacing_m);
   // Degenerate directions are held only at a prediction from another sensor (the fusion's
   // guess): LiDAR-only, the constant-velocity model knows less than the scan's weak constraint
-  // (racetrack launch seed 2: APE 0.16 -> 1.12 m when held there).
+  // (racetrack launch seed 2: APE 1.12 m held there, 0.16 m not).
   RegistrationConfig reg = config_.registration;
   reg.hold_degenerate_directions = reg.hold_degenerate_directions && fused_guess;
   // The kernel scale sigma / 3 follows the constant-velocity model's deviations; the fusion's
@@ -149,7 +149,7 @@ FrameResult ScanPipeline::process(const Scan& input, const std::optional<SE3>& i
 
   // 2. source covariances from the per-scan frame map (sensor frame), and the scan's density;
   // without a submap (the first scan) nothing reads the covariances: the frame map without them
-  // (KITTI's first frame: this stage 1.6 -> 0.5 ms on 2 threads, docs/performance.md)
+  // (KITTI's first frame: this stage 0.5 ms on 2 threads instead of 1.6 ms, docs/performance.md)
   t0 = Clock::now();
   const SourceSummary source = backend_->build_source(config_.density.close_range_m, backend_->map_voxels() > 0);
   out.source_points = source.points;

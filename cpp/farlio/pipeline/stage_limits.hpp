@@ -1,5 +1,5 @@
 #pragma once
-// How far each stage of a frame is from its limit (issue 14, docs/performance.md): the machine's
+// How far each stage of a frame is from its limit (docs/performance.md): the machine's
 // yardsticks, measured by two small kernels, and the time the work of a frame's stages implies at
 // those rates. The limit counts only the work no implementation of the stage can avoid:
 //   preprocess    read every raw point and its time (16 B), write the kept ones (12 B);

@@ -38,8 +38,8 @@ struct AddFactorSums {
 
 /// acc + the factor's terms, added in place (nothing without a correspondence: a term of zeros
 /// would leave the sums as they are). The CPU registration adds each point's factor to its task's
-/// sums with it (CpuExecutor::accumulate); building a FactorSums per point and adding it was 14 %
-/// of a Gauss-Newton iteration (BM_GicpIteration/1 1.00 -> 0.87 ms, stop 29).
+/// sums with it (CpuExecutor::accumulate); building a FactorSums per point and adding it would cost
+/// 14 % of a Gauss-Newton iteration (BM_GicpIteration/1).
 FARLIO_HD inline void add_factor(FactorSums& acc, bool found, const FactorTerms& f) {
   if (!found) return;
   for (int k = 0; k < kHEntries; ++k) acc.v[k] += static_cast<double>(f.H[k]);

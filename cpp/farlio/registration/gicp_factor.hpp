@@ -46,7 +46,7 @@ struct FactorParams {
 /// With J = R [I, -[s]x] the blocks of J^T Omega J need only A = R^T Omega R, which for GICP is
 /// (R^T C_q R + C_s)^-1: H = w [A, -A S; S A, -S A S] and b = w [A r'; s x (A r')] with S = [s]x
 /// and r' = R^T r, about half the arithmetic of forming J and the 6x6 product; the inverse from
-/// the symmetric cofactors (stop 27; tests/cpp/test_gicp.cpp checks it against that product).
+/// the symmetric cofactors (tests/cpp/test_gicp.cpp checks it against that product).
 FARLIO_HD inline bool gicp_factor_at(const map::ConstMapView& m, const Eigen::Vector4f& s, const map::Cov3& cov_s,
                                      const Eigen::Vector3f& p, std::int64_t nn, const FactorParams& fp,
                                      FactorTerms& out) {
