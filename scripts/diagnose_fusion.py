@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Where does the fusion lose accuracy? Runs the deterministic replay on generated sequences with one
 fusion part changed at a time and prints, per variant, the accuracy of the registered scan poses
-against the exact ground truth, next to LiDAR-only on the same data (docs/fusion.md, "Diagnosis").
+against the exact ground truth, next to LiDAR-only on the same data (CHANGELOG.md, "Diagnosis").
 
 Each variant isolates one part of the fusion:
   lidar_only      no fusion (the reference the LIO must not be worse than)

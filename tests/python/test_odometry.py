@@ -21,9 +21,9 @@ from farlio.simulation import generate
 # (profile, seconds, mode, scan-pose APE RMSE bound m, KITTI-style RPE bound %, 100 Hz odometry
 # APE bound m). Measured with a fixed 20 ms latency (seed 1), bounds ~3x above:
 #   urban 10 s     LIO: APE 0.006 m, RPE 0.05 %, odometry APE 0.007 m; LiDAR-only: 0.008 m, 0.07 %
-#   handheld 25 s  LIO: APE 0.009 m, RPE 0.14 %, odometry APE 0.012 m; LiDAR-only: 0.092 m, 1.9 %
+#   handheld 25 s  LIO: APE 0.006 m, RPE 0.12 %, odometry APE 0.007 m; LiDAR-only: 0.093 m, 2.0 %
 #   (these two: scripts/measure_accuracy.py)
-#   racetrack 6 s  LIO: APE 0.034 m, RPE 0.20 %, odometry APE 0.038 m; LiDAR-only: 0.051 m, 0.35 %
+#   racetrack 6 s  LIO: APE 0.040 m, RPE 0.23 %, odometry APE 0.049 m; LiDAR-only: 0.053 m, 0.31 %
 #                  (standing start, launch to 12 m/s: the case of docs/odometry.md "racetrack launch")
 # (LiDAR-only suffers from the 3 rad/s head turns under its constant-velocity model.)
 CASES = [
@@ -237,8 +237,8 @@ def test_a_fixed_latency_sweep_repeats_and_drops_by_the_wait_rule(tmp_path, sequ
 
 def test_racetrack_lio_beats_lidar_only(runs):
     # The same 6 s racetrack launch (fixed 20 ms latency). Measured with the bias states and the
-    # registration's covariance (docs/fusion.md): scan-pose APE 0.043 m with the LIO vs 0.051 m
-    # LiDAR-only, RPE 0.28 vs 0.35 %; the 30 s lap is in docs/fusion.md ("Never worse").
+    # registration's covariance (docs/fusion.md): scan-pose APE 0.040 m with the LIO vs 0.053 m
+    # LiDAR-only, RPE 0.23 vs 0.31 %; the 30 s lap is in docs/fusion.md ("IMU biases, ...").
     ape, rpe = {}, {}
     for mode in ("lio", "lidar"):
         s = runs("racetrack", 6.0, mode)[1]
