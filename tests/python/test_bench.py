@@ -159,3 +159,30 @@ def test_rounds_give_each_pass_its_ratio_next_to_kiss_icp():
     assert r["speedup_median"] == pytest.approx(
         r["kiss_icp"]["latency_ms"]["median"] / r["farlio"]["latency_ms"]["median"]
     )
+
+
+def test_a_recording_with_ground_truth_is_evaluated_as_farlio_run_evaluates_it(tmp_path):
+    # bench registers the LiDAR frame, farlio run writes the body frame: with the recording's
+    # ground truth moved into the LiDAR frame, the same LiDAR-only poses give the same APE
+    from farlio.config import load_config
+    from farlio.datasets import open_dataset
+    from farlio.runner import replay_options, run_dataset
+    from farlio.simulation import generate
+
+    seq = tmp_path / "urban"
+    generate("urban", seq, duration_s=4.0, seed=2)
+    out = tmp_path / "bench"
+    assert main(["bench", "--data", str(seq), "--scans", "40", "--no-kiss", "--device", "cpu", "--out", str(out)]) == 0
+    bench = json.loads((out / "bench.json").read_text())[str(seq)]["farlio"]["accuracy"]
+    assert bench is not None
+    run = run_dataset(
+        open_dataset(seq),
+        tmp_path / "run",
+        load_config(None, ["fusion.enabled=false", "device=cpu"]),
+        progress=False,
+        plot=False,
+        options=replay_options("zero"),
+    )
+    ape_run = run["accuracy"]["ape"]["translation_m"]["rmse"]
+    assert bench["ape_m"] < 0.05
+    assert abs(bench["ape_m"] - ape_run) < 2e-3, (bench["ape_m"], ape_run)

@@ -9,6 +9,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
+import farlio
 from farlio.benchmark import compare, format_table, generated_scans
 from farlio.cli_args import non_negative_int, positive_int
 from farlio.datasets import open_dataset
@@ -29,7 +30,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         type=Path,
         action="append",
         default=[],
-        help="also a recording (any format farlio run reads; repeatable)",
+        help="also a recording (any format farlio run reads; repeatable); where it has the true poses at its "
+        "scans (a sequence folder's groundtruth_scans.tum), both systems' APE and RPE against them",
     )
     parser.add_argument(
         "--threads",
@@ -70,7 +72,21 @@ def _data_sets(args: argparse.Namespace) -> Iterator[tuple[str, list[Any], Any]]
         yield profile, scans, gt
     for path in args.data:
         ds = open_dataset(path)
-        yield str(path), [ds.scan(i) for i in range(min(len(ds), args.scans))], None
+        yield str(path), [ds.scan(i) for i in range(min(len(ds), args.scans))], _lidar_groundtruth(ds)
+
+
+def _lidar_groundtruth(ds: Any) -> Any:
+    """The recording's true LiDAR poses at its scan ends (both systems register the LiDAR frame), or
+    None without a ground truth at the scans."""
+    body = ds.groundtruth_scans()
+    if body is None:
+        return None
+    T = ds.T_imu_lidar()
+    gt = farlio.Trajectory()
+    for k in range(len(body)):
+        stamp, pose = body[k]
+        gt.push_back(stamp, pose * T)
+    return gt
 
 
 def result_key(name: str, threads: int, several: bool) -> str:
