@@ -23,7 +23,7 @@ import argparse
 import math
 import sys
 
-from farlio.simulation import PROFILES, Recording, make_config, replay, stretch_accuracy
+from farlio.simulation import LIDAR_MODELS, PROFILES, Recording, make_config, replay, stretch_accuracy
 
 COLUMNS = ["ape_m", "rpe_pct", "rot_deg", "odom_ape_m", "odom_rpe_pct", "failed", "map_restarts", "reinit"]
 COLUMNS += ["rejected", "first_output_s"]
@@ -53,14 +53,23 @@ def main() -> int:
     p.add_argument("--duration", type=float, required=True, help="seconds recorded from there")
     p.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
     p.add_argument("--imu-grade", default="profile")
+    p.add_argument("--lidar", choices=LIDAR_MODELS, default="profile", help="the LiDAR model (farlio simulate --lidar)")
     p.add_argument("--no-reference", action="store_true", help="without the run started at rest")
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="NAME=VALUE")
     args = p.parse_args()
-    print(f"{args.profile}, {args.duration:g} s from {args.start:g} s into the motion; columns: {' '.join(COLUMNS)}")
+    print(
+        f"{args.profile} ({args.lidar} LiDAR), {args.duration:g} s from {args.start:g} s into the motion; "
+        f"columns: {' '.join(COLUMNS)}"
+    )
     for seed in args.seeds:
         cut = Recording(
             make_config(
-                args.profile, seed=seed, duration_s=args.duration, motion_start_s=args.start, imu_grade=args.imu_grade
+                args.profile,
+                seed=seed,
+                duration_s=args.duration,
+                motion_start_s=args.start,
+                imu_grade=args.imu_grade,
+                lidar=args.lidar,
             )
         )
         runs = {
@@ -69,7 +78,13 @@ def main() -> int:
         }
         if not args.no_reference:
             whole = Recording(
-                make_config(args.profile, seed=seed, duration_s=args.start + args.duration, imu_grade=args.imu_grade)
+                make_config(
+                    args.profile,
+                    seed=seed,
+                    duration_s=args.start + args.duration,
+                    imu_grade=args.imu_grade,
+                    lidar=args.lidar,
+                )
             )
             runs["standstill start"] = stretch_accuracy(replay(whole, args.overrides), from_s=args.start)
         print(f"seed {seed} (speed at the cut {cut.speed_at_start_m_s:.1f} m/s)")
