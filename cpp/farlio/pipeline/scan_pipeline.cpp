@@ -7,6 +7,7 @@
 
 #include "farlio/core/config_fields.hpp"
 #include "farlio/core/time.hpp"
+#include "farlio/map/adaptive_density.hpp"
 #include "farlio/pipeline/preprocess.hpp"
 
 namespace farlio::pipeline {
@@ -14,6 +15,19 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+/// Writes the seconds from its construction to its end into a stage's field of FrameTimings.
+class StageClock {
+ public:
+  explicit StageClock(double& seconds) : seconds_(seconds), start_(Clock::now()) {}
+  ~StageClock() { seconds_ = seconds_since(start_); }
+  StageClock(const StageClock&) = delete;
+  StageClock& operator=(const StageClock&) = delete;
+
+ private:
+  double& seconds_;
+  Clock::time_point start_;
+};
 
 // Used as the LiDAR period when neither stamps nor per-point times give one (10 Hz).
 constexpr double kFallbackPeriod_s = 0.1;
@@ -118,56 +132,65 @@ FrameResult ScanPipeline::process(const Scan& input, const std::optional<SE3>& i
     out.non_finite_points = finite->remove_non_finite();
   }
   const Scan& scan = finite ? *finite : input;
-
-  // 0. the first scan with points fixes the map's scale
-  if (!scale_fixed_ && !scan.empty()) {
-    scale_fixed_ = true;
-    const double voxel = scene_voxel_size_m(scan.points, config_.map);
-    if (voxel != config_.map.voxel_size_m) {
-      config_.map.voxel_size_m = voxel;
-      backend_->reset(config_);
-    }
-    config_.map.auto_voxel_size = false;  // the effective config states the size used
-  }
-  if (prior_map_ && !prior_map_loaded_ && scale_fixed_) {  // localization: the map at the scale fixed
-    const auto t_load = Clock::now();
-    backend_->load_map(*prior_map_);
-    prior_map_loaded_ = true;
-    t_start += Clock::now() - t_load;  // set-up, not this frame's work (the replay's latency)
-  }
-
-  // 1. preprocess: crop, undistort into the scan-end frame, downsample to the map spacing
-  auto t0 = Clock::now();
+  fix_scale(scan);              // 0. the first scan with points fixes the map's scale
+  t_start += load_prior_map();  // localization: set-up, not this frame's work (the replay's latency)
   const deskew::ScanMotion scan_motion =
       motion ? *motion
              : deskew::ScanMotion::constant_twist(last_twist().cast<float>(), static_cast<float>(scan.duration_s()));
+  preprocess(scan, scan_motion, out);                                       // 1.
+  const map::PointLimit limit = build_source(out);                          // 2.
+  register_scan(scan, scan_motion, initial_guess, guess_from_fusion, out);  // 3.
+  update_map(scan.end_stamp_ns, limit, out);                                // 4.
+  advance(scan.end_stamp_ns, out.pose, out);                                // 5.
+  backend_->device_stage_times(out.timings);
+  out.timings.total_s = seconds_since(t_start);
+  return out;
+}
+
+void ScanPipeline::fix_scale(const Scan& scan) {
+  if (scale_fixed_ || scan.empty()) return;
+  scale_fixed_ = true;
+  const double voxel = scene_voxel_size_m(scan.points, config_.map);
+  if (voxel != config_.map.voxel_size_m) {
+    config_.map.voxel_size_m = voxel;
+    backend_->reset(config_);
+  }
+  config_.map.auto_voxel_size = false;  // the effective config states the size used
+}
+
+std::chrono::steady_clock::duration ScanPipeline::load_prior_map() {
+  if (!prior_map_ || prior_map_loaded_ || !scale_fixed_) return Clock::duration::zero();
+  const auto t0 = Clock::now();
+  backend_->load_map(*prior_map_);  // at the scale fixed
+  prior_map_loaded_ = true;
+  return Clock::now() - t0;
+}
+
+void ScanPipeline::preprocess(const Scan& scan, const deskew::ScanMotion& scan_motion, FrameResult& out) {
+  // crop, undistort into the scan-end frame, downsample to the map spacing
+  const StageClock clock(out.timings.preprocess_s);
   const bool undistort = config_.preprocess.undistort && scan.has_time() && !scan_motion.is_identity();
   out.motion = scan_motion;
   out.undistorted = undistort;
   out.kept_points = backend_->preprocess(scan, scan_motion, undistort);
-  out.timings.preprocess_s = seconds_since(t0);
+}
 
-  // 2. source covariances from the per-scan frame map (sensor frame), and the scan's density;
-  // without a submap (the first scan) nothing reads the covariances: the frame map without them
-  // (KITTI's first frame: this stage 0.5 ms on 2 threads instead of 1.6 ms, docs/performance.md)
-  t0 = Clock::now();
+map::PointLimit ScanPipeline::build_source(FrameResult& out) {
+  // source covariances from the per-scan frame map (sensor frame), and the scan's density, which
+  // sets the submap's limit (ASMD); without a submap (the first scan) nothing reads the
+  // covariances: the frame map without them (KITTI's first frame: this stage 0.5 ms on 2 threads
+  // instead of 1.6 ms, docs/performance.md)
+  const StageClock clock(out.timings.covariance_s);
   const SourceSummary source = backend_->build_source(config_.density.close_range_m, backend_->map_voxels() > 0);
   out.source_points = source.points;
-  const int n_max = config_.map.max_points_per_voxel, k = config_.map.covariance_neighbors;
-  map::PointLimit limit = map::PointLimit::constant(n_max);
-  if (config_.density.enabled) {
-    const double density = source.mean_points_per_voxel;
-    if (density > 0) {
-      const int close = std::clamp(static_cast<int>(density), k, n_max);
-      limit = {close, static_cast<float>(config_.density.close_range_m),
-               static_cast<float>(config_.density.slope_points_per_m), std::min(k, close)};
-    }
-  }
+  const map::PointLimit limit = map::adaptive_point_limit(source.mean_points_per_voxel, config_.density, config_.map);
   out.density_limit = limit.close_limit;
-  out.timings.covariance_s = seconds_since(t0);
+  return limit;
+}
 
-  // 3. registration against the submap
-  t0 = Clock::now();
+void ScanPipeline::register_scan(const Scan& scan, const deskew::ScanMotion& scan_motion,
+                                 const std::optional<SE3>& initial_guess, bool guess_from_fusion, FrameResult& out) {
+  const StageClock clock(out.timings.registration_s);
   const double period_s = frames_ > 0 && scan.end_stamp_ns > last_stamp_ns_
                               ? ns_to_seconds(scan.end_stamp_ns - last_stamp_ns_)
                               : (scan.duration_s() > 0 ? scan.duration_s() : kFallbackPeriod_s);
@@ -180,65 +203,66 @@ FrameResult ScanPipeline::process(const Scan& input, const std::optional<SE3>& i
   out.sigma_m = motion_unknown
                     ? std::max(threshold_.sigma_m(), registration::sigma_without_motion_model_m(config_.threshold))
                     : threshold_.sigma_m();
-  SE3 pose = out.initial_guess;
-  if (backend_->map_voxels() > 0 && source.points > 0) {
+  out.pose = out.initial_guess;
+  if (backend_->map_voxels() > 0 && out.source_points > 0) {
     const double time_budget_s = config_.registration.time_budget_factor * period_s;
-    out.failure = register_frame(out, fused_guess, source.points, time_budget_s);
+    out.failure = register_frame(out, fused_guess, out.source_points, time_budget_s);
     if (out.failure.empty()) {
-      pose = out.registration.pose;
-      threshold_.update(out.initial_guess.inverse() * pose);
+      out.pose = out.registration.pose;
+      threshold_.update(out.initial_guess.inverse() * out.pose);
     }
-    // The first scan and this one were undistorted without the motion just found. Both are
-    // smeared alike, so the registration of one against the other stands; the map starts again
-    // from this scan undistorted with that motion (the first scan leaves it).
-    if (motion_unknown && out.failure.empty() && config_.preprocess.undistort && scan.has_time()) {
-      const deskew::ScanMotion found = deskew::ScanMotion::constant_twist(
-          twist_between(last_pose_, pose, last_stamp_ns_, scan.end_stamp_ns).cast<float>(),
-          static_cast<float>(scan.duration_s()));
-      if (motion_deviation_m(scan_motion, found, config_.threshold) > config_.threshold.min_motion_m) {
-        out.motion = found;
-        out.undistorted = true;
-        out.kept_points = backend_->preprocess(scan, found, true);
-        out.source_points = backend_->build_source(config_.density.close_range_m, false).points;
-        backend_->reset(config_);
-        out.map_started_here = true;
-      }
-    }
+    if (motion_unknown && out.failure.empty()) restart_map_with_found_motion(scan, scan_motion, out);
   } else if (backend_->map_voxels() > 0) {
     out.failure = "nothing to register against (no points after preprocessing)";
   }
-  out.pose = pose;
   out.lost = localizing() && !out.failure.empty();
-  out.timings.registration_s = seconds_since(t0);
+}
 
-  // 4. submap update with the adaptive density, then removal of far voxels. A failed scan
-  // changes nothing, unless failures have lasted map_restart_after_s: then the map restarts
-  // from this scan at the prediction (recovery when the old map no longer matches). A prior
-  // map (localization) is held fixed.
-  t0 = Clock::now();
+void ScanPipeline::restart_map_with_found_motion(const Scan& scan, const deskew::ScanMotion& scan_motion,
+                                                 FrameResult& out) {
+  // The first scan and this one were undistorted without the motion just found. Both are smeared
+  // alike, so the registration of one against the other stands; the map starts again from this
+  // scan undistorted with that motion (the first scan leaves it).
+  if (!config_.preprocess.undistort || !scan.has_time()) return;
+  const deskew::ScanMotion found = deskew::ScanMotion::constant_twist(
+      twist_between(last_pose_, out.pose, last_stamp_ns_, scan.end_stamp_ns).cast<float>(),
+      static_cast<float>(scan.duration_s()));
+  if (motion_deviation_m(scan_motion, found, config_.threshold) <= config_.threshold.min_motion_m) return;
+  out.motion = found;
+  out.undistorted = true;
+  out.kept_points = backend_->preprocess(scan, found, true);
+  out.source_points = backend_->build_source(config_.density.close_range_m, false).points;
+  backend_->reset(config_);
+  out.map_started_here = true;
+}
+
+void ScanPipeline::update_map(std::int64_t stamp_ns, const map::PointLimit& limit, FrameResult& out) {
+  // submap update with the adaptive density, then removal of far voxels. A failed scan changes
+  // nothing, unless failures have lasted map_restart_after_s: then the map restarts from this
+  // scan at the prediction (recovery when the old map no longer matches). A prior map
+  // (localization) is held fixed.
+  const StageClock clock(out.timings.map_update_s);
   if (!localizing()) {
-    out.map_restarted = restart_map_after_failures(scan.end_stamp_ns, out);
+    out.map_restarted = restart_map_after_failures(stamp_ns, out);
     if (out.failure.empty() || out.map_restarted)
-      out.map_insert = backend_->update_map(pose, limit, &out.removed_voxels);
+      out.map_insert = backend_->update_map(out.pose, limit, &out.removed_voxels);
   }
   out.map_voxels = backend_->map_voxels();
   out.map_points = backend_->map_points();
-  out.timings.map_update_s = seconds_since(t0);
+}
 
-  // 5. velocity from consecutive poses (eq. 6) and the constant-velocity state
-  if (frames_ > 0 && scan.end_stamp_ns > last_stamp_ns_) {
-    const double dt = ns_to_seconds(scan.end_stamp_ns - last_stamp_ns_);
+void ScanPipeline::advance(std::int64_t stamp_ns, const SE3& pose, FrameResult& out) {
+  // velocity from consecutive poses (eq. 6) and the constant-velocity state
+  if (frames_ > 0 && stamp_ns > last_stamp_ns_) {
+    const double dt = ns_to_seconds(stamp_ns - last_stamp_ns_);
     out.velocity_body_m_s = velocity_from_poses(last_pose_, pose, dt);
     out.angular_velocity_body_rad_s = (last_pose_.inverse() * pose).log().tail<3>() / dt;
   }
   prev_pose_ = last_pose_;
   prev_stamp_ns_ = last_stamp_ns_;
   last_pose_ = pose;
-  last_stamp_ns_ = scan.end_stamp_ns;
+  last_stamp_ns_ = stamp_ns;
   ++frames_;
-  backend_->device_stage_times(out.timings);
-  out.timings.total_s = seconds_since(t_start);
-  return out;
 }
 
 }  // namespace farlio::pipeline

@@ -9,6 +9,7 @@
 // otherwise from a constant-velocity model (LiDAR-only odometry). Poses are of the LiDAR frame
 // at the scan's end stamp. The stages run on a ScanBackend (CPU executor or CUDA, chosen by
 // config.device).
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -105,6 +106,26 @@ class ScanPipeline {
   [[nodiscard]] registration::Vec6d last_twist() const;
 
  private:
+  // The steps of process(), in order (paper Fig. 2):
+  /// The first scan with points fixes the map's voxel size (map.auto_voxel_size).
+  void fix_scale(const Scan& scan);
+  /// Localization: loads the prior map once the scale is fixed; returns how long that took.
+  std::chrono::steady_clock::duration load_prior_map();
+  /// 1. Crop, undistortion with scan_motion, downsampling (out: motion, undistorted, kept_points).
+  void preprocess(const Scan& scan, const deskew::ScanMotion& scan_motion, FrameResult& out);
+  /// 2. The source and its covariances; returns the submap's per-voxel limit (ASMD).
+  map::PointLimit build_source(FrameResult& out);
+  /// 3. Registration against the submap from the fusion's guess or the constant-velocity
+  /// prediction (out: initial_guess, sigma_m, pose, failure, lost, ...).
+  void register_scan(const Scan& scan, const deskew::ScanMotion& scan_motion, const std::optional<SE3>& initial_guess,
+                     bool guess_from_fusion, FrameResult& out);
+  /// After the first registration: when it found the body moving, this scan is undistorted again
+  /// with that motion and the map starts again from it (out.map_started_here).
+  void restart_map_with_found_motion(const Scan& scan, const deskew::ScanMotion& scan_motion, FrameResult& out);
+  /// 4. Submap update with the limit, removal of far voxels, restart after lasting failures.
+  void update_map(std::int64_t stamp_ns, const map::PointLimit& limit, FrameResult& out);
+  /// 5. Velocity from consecutive poses (eq. 6), and the constant-velocity state moves on.
+  void advance(std::int64_t stamp_ns, const SE3& pose, FrameResult& out);
   /// GICP of the frame's source from out.initial_guess at out.sigma_m (sets out.registration,
   /// registered, inlier_fraction, kernel_scale_m); returns why its pose must not be used (empty
   /// when it may). fused_guess: the guess is the fusion's.
