@@ -52,15 +52,19 @@ def generated_scans(profile: str, scans: int, seed: int = 1) -> tuple[list[Any],
     cfg.duration_s = (skip + scans + 1) * period
     gen = _core.sim.SequenceGenerator(cfg)
     out = [gen.scan(i) for i in range(skip, skip + scans)]
-    gt_body = gen.groundtruth_scans()
     T = gen.T_imu_lidar()
-    gt = farlio.Trajectory()
-    ends = {s.end_stamp_ns for s in out}
-    for k in range(len(gt_body)):
-        stamp, pose = gt_body[k]
-        if stamp in ends:
-            gt.push_back(stamp, pose * T)
-    return out, gt, T
+    return out, lidar_poses(gen.groundtruth_scans(), T, {s.end_stamp_ns for s in out}), T
+
+
+def lidar_poses(body: Any, T_imu_lidar: Any, stamps: set[int] | None = None) -> Any:
+    """Body (IMU) poses as LiDAR poses (what farlio's scan pipeline and KISS-ICP register), at every
+    stamp or at those of `stamps` only."""
+    out = farlio.Trajectory()
+    for k in range(len(body)):
+        stamp, pose = body[k]
+        if stamps is None or stamp in stamps:
+            out.push_back(stamp, pose * T_imu_lidar)
+    return out
 
 
 def _median_p99(ms: Sequence[float]) -> dict[str, float]:

@@ -71,8 +71,7 @@ registration::Vec6d ScanPipeline::last_twist() const {
   return twist_between(prev_pose_, last_pose_, prev_stamp_ns_, last_stamp_ns_);
 }
 
-std::string ScanPipeline::register_frame(FrameResult& out, bool fused_guess, std::size_t source_points,
-                                         double time_budget_s) {
+std::string ScanPipeline::register_frame(FrameResult& out, bool fused_guess, double time_budget_s) {
   // the spacing as the backends' maps hold it (float)
   const auto spacing_m = static_cast<float>(map::point_spacing_m(config_.map));
   const double p2p =
@@ -90,8 +89,8 @@ std::string ScanPipeline::register_frame(FrameResult& out, bool fused_guess, std
   out.kernel_scale_m = thresholds.kernel_scale_m;
   out.registration = backend_->register_source(out.initial_guess, thresholds, reg, time_budget_s);
   out.registered = true;
-  out.inlier_fraction = static_cast<double>(out.registration.system.inliers) / static_cast<double>(source_points);
-  std::string failure = registration::failure_reason(out.registration, source_points, config_.registration);
+  out.inlier_fraction = static_cast<double>(out.registration.system.inliers) / static_cast<double>(out.source_points);
+  std::string failure = registration::failure_reason(out.registration, out.source_points, config_.registration);
   if (failure.empty() && localizing() && out.inlier_fraction < config_.localization.min_inlier_fraction) {
     failure = "not localized: " + std::to_string(static_cast<int>(100.0 * out.inlier_fraction)) +
               " % of the points match the prior map (localization.min_inlier_fraction)";
@@ -206,7 +205,7 @@ void ScanPipeline::register_scan(const Scan& scan, const deskew::ScanMotion& sca
   out.pose = out.initial_guess;
   if (backend_->map_voxels() > 0 && out.source_points > 0) {
     const double time_budget_s = config_.registration.time_budget_factor * period_s;
-    out.failure = register_frame(out, fused_guess, out.source_points, time_budget_s);
+    out.failure = register_frame(out, fused_guess, time_budget_s);
     if (out.failure.empty()) {
       out.pose = out.registration.pose;
       threshold_.update(out.initial_guess.inverse() * out.pose);

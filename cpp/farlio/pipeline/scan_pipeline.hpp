@@ -127,9 +127,9 @@ class ScanPipeline {
   /// 5. Velocity from consecutive poses (eq. 6), and the constant-velocity state moves on.
   void advance(std::int64_t stamp_ns, const SE3& pose, FrameResult& out);
   /// GICP of the frame's source from out.initial_guess at out.sigma_m (sets out.registration,
-  /// registered, inlier_fraction, kernel_scale_m); returns why its pose must not be used (empty
-  /// when it may). fused_guess: the guess is the fusion's.
-  std::string register_frame(FrameResult& out, bool fused_guess, std::size_t source_points, double time_budget_s);
+  /// registered, inlier_fraction, kernel_scale_m) over out.source_points; returns why its pose must
+  /// not be used (empty when it may). fused_guess: the guess is the fusion's.
+  std::string register_frame(FrameResult& out, bool fused_guess, double time_budget_s);
   /// Tracks failures in a row; after map_restart_after_s of them, empties the submap (a scan with
   /// points then starts it again) and returns true.
   bool restart_map_after_failures(std::int64_t stamp_ns, const FrameResult& result);

@@ -9,8 +9,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-import farlio
-from farlio.benchmark import compare, format_table, generated_scans
+from farlio.benchmark import compare, format_table, generated_scans, lidar_poses
 from farlio.cli_args import non_negative_int, positive_int
 from farlio.datasets import open_dataset
 from farlio.runner import DEVICES
@@ -76,17 +75,9 @@ def _data_sets(args: argparse.Namespace) -> Iterator[tuple[str, list[Any], Any]]
 
 
 def _lidar_groundtruth(ds: Any) -> Any:
-    """The recording's true LiDAR poses at its scan ends (both systems register the LiDAR frame), or
-    None without a ground truth at the scans."""
+    """The recording's true LiDAR poses at its scan ends, or None without a ground truth at the scans."""
     body = ds.groundtruth_scans()
-    if body is None:
-        return None
-    T = ds.T_imu_lidar()
-    gt = farlio.Trajectory()
-    for k in range(len(body)):
-        stamp, pose = body[k]
-        gt.push_back(stamp, pose * T)
-    return gt
+    return None if body is None else lidar_poses(body, ds.T_imu_lidar())
 
 
 def result_key(name: str, threads: int, several: bool) -> str:
