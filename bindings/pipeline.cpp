@@ -148,6 +148,7 @@ void bind_pipeline(nb::module_& m) {
   nb::class_<Config>(m, "Config",
                      "The one parameter set; fields by dotted name, e.g. 'map.voxel_size_m', with their types.")
       .def(nb::init<>())
+      .def(nb::init<const Config&>(), "other"_a, "A copy of other.")
       .def(
           "set",
           [](Config& c, const std::string& name, nb::handle value) { set_config_field(c, name, text_of(value)); },
@@ -486,6 +487,14 @@ void bind_pipeline(nb::module_& m) {
           },
           "scan"_a, "result"_a, nb::call_guard<nb::gil_scoped_release>(),
           "Adds a processed scan at its pose with the motion it was undistorted with; returns the points added.")
+      .def(
+          "add",
+          [](PyMapExport& e, const Scan& scan, const pipeline::FrameResult& r, const SE3& pose) {
+            return locked(e, [&](PyMapExport& x) { return x.map.add(scan, r.motion, r.undistorted, pose); });
+          },
+          "scan"_a, "result"_a, "pose"_a, nb::call_guard<nb::gil_scoped_release>(),
+          "Adds a processed scan undistorted with the motion of its result, placed at `pose` (the LiDAR pose at "
+          "the scan end in this map's frame: a keyframe's submap, a corrected trajectory); returns the points added.")
       .def(
           "points", [](PyMapExport& e) { return locked(e, [](PyMapExport& x) { return x.map.points(); }); },
           nb::call_guard<nb::gil_scoped_release>(),

@@ -22,6 +22,7 @@ import farlio
 from farlio import _core
 
 MAP_PLY, MAP_PCD = "map.ply", "map.pcd"
+MAP_GLOBAL_PLY, MAP_GLOBAL_PCD, MAP_GLOBAL_PNG = "map_global.ply", "map_global.pcd", "map_global.png"
 #: where the whole map's tiles the sensor has left wait during a run (removed at its end)
 SPILL_DIR = ".map_tiles"
 MS_PER_S = 1e3
@@ -33,12 +34,14 @@ INITIAL_POSE_VALUES = 6
 class MapOptions:
     """What a run does with maps: save (--save-map) at resolution_m (None: the config's
     map.export_resolution_m, whose 0 means the map's point spacing); localize in prior_map
-    (--prior-map) starting from initial_pose (X Y Z m, ROLL PITCH YAW deg; None: the origin)."""
+    (--prior-map) starting from initial_pose (X Y Z m, ROLL PITCH YAW deg; None: the origin); close
+    loops (--loop-closure)."""
 
     save: bool = False
     resolution_m: float | None = None
     prior_map: Path | None = None
     initial_pose: Sequence[float] | None = None
+    loop_closure: bool = False  # --loop-closure: the global trajectory (loop_closure.py)
 
 
 def pose_from_xyz_rpy_deg(values: Sequence[float]) -> Any:
@@ -116,3 +119,28 @@ class WholeMap:
         }
         self.export = None  # removes the tiles' files and the folder
         return summary
+
+
+def downsample(points: np.ndarray, resolution_m: float) -> np.ndarray:
+    """One centroid per cell of resolution_m."""
+    if len(points) == 0:
+        return points
+    keys = np.floor(points / resolution_m).astype(np.int64)
+    _, inverse, counts = np.unique(keys, axis=0, return_inverse=True, return_counts=True)
+    sums = np.zeros((len(counts), 3))
+    np.add.at(sums, inverse.ravel(), points)
+    return (sums / counts[:, None]).astype(np.float32)
+
+
+def write_global_map(loops: Any, resolution_m: float, out_dir: Path, trajectory: Path, plot: bool) -> dict[str, Any]:
+    """map_global.pcd, map_global.ply (and map_global.png): every keyframe's segment at its
+    optimised pose, one centroid per cell; returns the summary's entry."""
+    points = downsample(loops.global_points(), resolution_m)
+    cloud = farlio.Scan(points)
+    _core.io.write_pcd(out_dir / MAP_GLOBAL_PCD, cloud)
+    _core.io.write_ply(out_dir / MAP_GLOBAL_PLY, cloud)
+    if plot:
+        from .plots import plot_map
+
+        plot_map(points, trajectory, out_dir / MAP_GLOBAL_PNG)
+    return {"points": len(points), "resolution_m": resolution_m}

@@ -14,6 +14,10 @@ Outputs in the output folder (every trajectory file names its frame):
   map.pcd, map.ply, map.png   the whole map (every scan whose pose was used, one centroid per cell
                          of the export resolution, with intensity), world frame, and its picture
                          from above (with --save-map; mapping.py)
+  scans_lidar_global.tum, scans_body_global.tum, loops.csv   with --loop-closure: every scan's pose
+                         after loop closure and the verified loop candidates (loop_closure.py);
+                         eval_scans_global/ against the ground truth; with --save-map also
+                         map_global.pcd, map_global.ply, map_global.png (the map at those poses)
   trajectory.png, latency.png   the estimated path (with ground truth) and the latency histogram (with plot)
 """
 
@@ -35,7 +39,8 @@ from farlio._core import NS_PER_S
 
 from .config import config_to_yaml
 from .datasets import Dataset
-from .mapping import MapOptions, WholeMap, load_prior_map
+from .loop_closure import SCANS_BODY_GLOBAL_TUM, SCANS_LIDAR_GLOBAL_TUM, LoopClosure
+from .mapping import MapOptions, WholeMap, load_prior_map, write_global_map
 from .progress import Progress
 from .timing_csv import MS_PER_S, TIMING_CSV, TimingCsv
 
@@ -49,7 +54,7 @@ LATENCY_MODELS = {
 CONFIG_YAML, SUMMARY_JSON = "config.yaml", "summary.json"
 SCANS_LIDAR_TUM, SCANS_BODY_TUM, ODOMETRY_TUM = "scans_lidar.tum", "scans_body.tum", "odometry_body.tum"
 SCANS_LIDAR_KITTI = "scans_lidar_kitti.txt"
-EVAL_SCANS_DIR, EVAL_ODOMETRY_DIR = "eval_scans", "eval_odometry"
+EVAL_SCANS_DIR, EVAL_ODOMETRY_DIR, EVAL_GLOBAL_DIR = "eval_scans", "eval_odometry", "eval_scans_global"
 MEDIAN_PERCENTILE, TAIL_PERCENTILE = 50, 99
 #: fewer registered poses than this are not evaluated
 MIN_EVALUATED_POSES = 3
@@ -107,6 +112,8 @@ def run_dataset(
     summary = run.summarise()
     if run.whole_map is not None:
         summary["map"] = run.whole_map.write(run.out_dir, run.out_dir / SCANS_LIDAR_TUM, plot)
+    if run.loops is not None:
+        summary["loop_closure"] = run.close_loops(plot)
     run.evaluate(summary, groundtruth, plot)
     if plot:
         run.plot(summary)
@@ -139,6 +146,7 @@ class OdometryRun:
         self.dataset, self.out_dir, self.config = dataset, out_dir, config
         self.maps = maps or MapOptions()
         self.whole_map = WholeMap(self.maps.resolution_m, out_dir) if self.maps.save else None
+        self.loops: LoopClosure | None = None  # with --loop-closure, once the odometry exists
         self.prior_map_points = 0
         self.frames = 0
         self.counts = FrameCounts()
@@ -161,6 +169,8 @@ class OdometryRun:
             self.check_clocks()
         self.odo = _core.Odometry(self.config, self.dataset.T_imu_lidar(), self.dataset.gravity_m_s2(), imu, options)
         self.prior_map_points = load_prior_map(self.odo, self.maps)
+        if self.maps.loop_closure:
+            self.loops = LoopClosure(self.config, self.dataset.T_imu_lidar())
         self.warn_from_odometry()
         if self.odo.device_message:
             print(f"farlio: {self.odo.device_message}", file=sys.stderr)
@@ -243,6 +253,8 @@ class OdometryRun:
         self.record(fr)
         if self.whole_map is not None:
             self.whole_map.add(self.odo, scan, fr)
+        if self.loops is not None and not fr.scan.failure and not fr.scan.lost:
+            self.loops.add(self.odo, scan, fr.scan)
         if on_frame is not None:
             on_frame(i, scan, fr)
         bar.update(i + 1, f"{fr.scan.timings.total_s * MS_PER_S:6.1f} ms")
@@ -341,6 +353,18 @@ class OdometryRun:
             }
         return summary
 
+    def close_loops(self, plot: bool) -> dict[str, Any]:
+        """The last keyframe's search, the global trajectory and loops.csv (and the global map with
+        --save-map); returns the summary's "loop_closure" entry."""
+        self.loops.finish()
+        summary = self.loops.write(self.out_dir)
+        if self.whole_map is not None:
+            resolution = self.maps.resolution_m or _core.export_resolution_m(self.odo.effective_config)
+            summary["map"] = write_global_map(
+                self.loops, resolution, self.out_dir, self.out_dir / SCANS_LIDAR_GLOBAL_TUM, plot
+            )
+        return summary
+
     def evaluate(self, summary: dict[str, Any], groundtruth: Path | None, plot: bool) -> None:
         """Accuracy of the scan poses and of the 100 Hz odometry against the ground truth, when there
         is one: eval_scans/, eval_odometry/ and summary["accuracy"], summary["accuracy_odometry"]."""
@@ -357,6 +381,10 @@ class OdometryRun:
             summary["accuracy"] = evaluate_files(
                 self.out_dir / SCANS_BODY_TUM, Path(gt_scans), self.out_dir / EVAL_SCANS_DIR, plot=plot
             )
+            if self.loops is not None and len(self.loops.keyframes):
+                summary["accuracy_global"] = evaluate_files(
+                    self.out_dir / SCANS_BODY_GLOBAL_TUM, Path(gt_scans), self.out_dir / EVAL_GLOBAL_DIR, plot=plot
+                )
         gt_dense = groundtruth or self.dataset.groundtruth()
         if gt_dense is not None and self.odom_tum is not None and len(self.odom_tum) >= MIN_EVALUATED_POSES:
             summary["accuracy_odometry"] = evaluate_files(
@@ -459,7 +487,17 @@ def format_summary(s: dict[str, Any]) -> str:
     if s.get("map"):
         m = s["map"]
         lines.append(f"map: {m['points']} points at {m['resolution_m'] or 0:.2f} m (map.pcd, map.ply, map.png)")
-    for key, label in (("accuracy", "scan poses"), ("accuracy_odometry", "100 Hz odometry")):
+    if s.get("loop_closure"):
+        lc = s["loop_closure"]
+        lines.append(
+            f"loop closure: {lc['accepted']} of {lc['candidates']} verified loops accepted over {lc['keyframes']} "
+            f"keyframes (scans_body_global.tum, loops.csv), {lc['verify_s']:.1f} s verifying"
+        )
+    for key, label in (
+        ("accuracy", "scan poses"),
+        ("accuracy_odometry", "100 Hz odometry"),
+        ("accuracy_global", "scan poses after loop closure"),
+    ):
         if s.get(key):
             lines.append(f"{label}: {_accuracy_line(s[key])}")
     return "\n".join(lines)

@@ -299,6 +299,20 @@ inline constexpr double kMaxThreads = 1024.0;
         "a scan registered in the prior map that matches fewer of its source points is lost (timing.csv) and " \
         "its pose not used: a scan of the mapped scene matches 0.97-0.99, the ground alone 30 m off 0.8")
 
+// ---- loop: loop closure over a whole run (farlio run --loop-closure; docs/maps.md) ------------
+#define FARLIO_LOOP_FIELDS(FIELD)                                                                                  \
+  FIELD(double, keyframe_distance_m, 10.0, range::positive_up_to(kMaxDistance_m),                                  \
+        "a keyframe (a pose-graph node) starts after this much travel; its scans until the next form its segment") \
+  FIELD(double, submap_length_m, 40.0, range::positive_up_to(kMaxDistance_m),                                      \
+        "a keyframe's submap: its segment and those of this much path before it (what a loop registers)")          \
+  FIELD(double, search_radius_m, 15.0, range::positive_up_to(kMaxDistance_m),                                      \
+        "candidates lie within this distance of the query (global estimate), plus 0.5 % of the path between them") \
+  FIELD(double, min_overlap, 0.5, range::fraction(),                                                               \
+        "a loop is refused unless this fraction of the query submap's cells land on the candidate's map")          \
+  FIELD(double, max_ambiguity_m, 0.3, range::positive_up_to(kMaxDistance_m),                                       \
+        "a loop is refused when registrations started 4 m and 10 deg around it end farther apart (repeated "       \
+        "structure: evenly spaced posts, identical corridors)")
+
 #define FARLIO_TOP_FIELDS(FIELD)                                                           \
   FIELD(Device, device, Device::Auto, range::unchecked(),                                  \
         "scan pipeline backend: auto (CUDA when a GPU is present, else CPU), cpu or cuda") \
@@ -327,6 +341,9 @@ struct FusionConfig {
 struct LocalizationConfig {
   FARLIO_LOCALIZATION_FIELDS(FARLIO_CONFIG_MEMBER)
 };
+struct LoopClosureConfig {
+  FARLIO_LOOP_FIELDS(FARLIO_CONFIG_MEMBER)
+};
 struct CudaConfig {
   FARLIO_CUDA_FIELDS(FARLIO_CONFIG_MEMBER)
 };
@@ -339,6 +356,7 @@ struct Config {
   RegistrationConfig registration;
   FusionConfig fusion;
   LocalizationConfig localization;
+  LoopClosureConfig loop;
   CudaConfig cuda;
   FARLIO_TOP_FIELDS(FARLIO_CONFIG_MEMBER)
 };

@@ -25,6 +25,7 @@ FARLIO_SECTION_FIELDS(ThresholdConfig, FARLIO_THRESHOLD_FIELDS)
 FARLIO_SECTION_FIELDS(RegistrationConfig, FARLIO_REGISTRATION_FIELDS)
 FARLIO_SECTION_FIELDS(FusionConfig, FARLIO_FUSION_FIELDS)
 FARLIO_SECTION_FIELDS(LocalizationConfig, FARLIO_LOCALIZATION_FIELDS)
+FARLIO_SECTION_FIELDS(LoopClosureConfig, FARLIO_LOOP_FIELDS)
 FARLIO_SECTION_FIELDS(CudaConfig, FARLIO_CUDA_FIELDS)
 FARLIO_SECTION_FIELDS(Config, FARLIO_TOP_FIELDS)
 
@@ -150,6 +151,7 @@ std::vector<ConfigField> config_fields(Config& c) {
   append_fields(out, c.registration, "registration.");
   append_fields(out, c.fusion, "fusion.");
   append_fields(out, c.localization, "localization.");
+  append_fields(out, c.loop, "loop.");
   append_fields(out, c.cuda, "cuda.");
   append_fields(out, c, "");
   return out;
@@ -232,6 +234,7 @@ void validate_config(const Config& config) {
   check_ranges(config.registration, "registration");
   validate_config(config.fusion);
   check_ranges(config.localization, "localization");
+  check_ranges(config.loop, "loop");
   check_ranges(config.cuda, "cuda");
   Config copy = config;
   std::vector<ConfigField> top;

@@ -133,6 +133,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "voxel_size_m / sqrt(max_points_per_voxel))",
     )
     maps.add_argument(
+        "--loop-closure",
+        action="store_true",
+        help="close loops (needs pip install 'farlio[mapping]'): keyframes every loop.keyframe_distance_m, "
+        "revisited places found near the current global estimate and verified by GICP (overlap, ambiguity), "
+        "a pose graph optimised with gtsam; writes scans_lidar_global.tum, scans_body_global.tum and loops.csv "
+        "(with --save-map also map_global.pcd/.ply/.png); the odometry's outputs are unchanged (docs/maps.md)",
+    )
+    maps.add_argument(
         "--prior-map",
         type=Path,
         default=None,
@@ -193,7 +201,7 @@ def run(args: argparse.Namespace) -> int:
         args.out,
         config,
         max_frames=args.max_frames,
-        maps=MapOptions(args.save_map, args.map_resolution, args.prior_map, args.initial_pose),
+        maps=MapOptions(args.save_map, args.map_resolution, args.prior_map, args.initial_pose, args.loop_closure),
         groundtruth=args.gt,
         progress=False if args.no_progress else None,
         plot=not args.no_plot,

@@ -1,0 +1,339 @@
+"""Loop closure: a globally consistent trajectory from the odometry's scans (farlio run
+--loop-closure).
+
+Along the odometry, a keyframe starts every loop.keyframe_distance_m of travel; the scans until
+the next one (undistorted with the motion the odometry used, at the export resolution) form its
+segment, in the keyframe's frame. A keyframe's submap is its segment with those of the
+loop.submap_length_m of path before it. When a keyframe's segment is complete:
+
+1. candidates: earlier keyframes at least MIN_LOOP_TRAVEL_FACTOR submap lengths back along the
+   path whose global position (the pose graph's current estimate) lies within loop.search_radius_m
+   plus SEARCH_DRIFT of the path between them; the nearest is verified;
+2. verification by farlio's own GICP (register_pair), coarse to fine from the graph's guess: the
+   query's submap against the candidate's (and its neighbours'), accepted only when
+   - at least loop.min_overlap of the query's cells land on the candidate's map, and
+   - the same registration started AMBIGUITY_OFFSET_M away along each horizontal axis (and
+     AMBIGUITY_YAW_RAD turned) comes back within loop.max_ambiguity_m of the same pose: a straight
+     with evenly spaced posts or two identical corridors let a registration lock onto the wrong
+     copy, and then the starts disagree;
+3. the pose graph (pose_graph.py) gets the loop edge and is optimised (iSAM2).
+
+After a loop is accepted the next loop.submap_length_m of travel is not searched (one loop per
+submap is enough to hold the graph, and verification is the expensive step).
+
+Outputs (write): scans_lidar_global.tum and scans_body_global.tum, every scan's pose corrected
+through its keyframe, and loops.csv, every verified candidate with its figures and the reason it
+was refused. The odometry's own outputs are unchanged."""
+
+from __future__ import annotations
+
+import csv
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+import farlio
+from farlio import _core
+
+from .pose_graph import PoseGraph
+
+SCANS_LIDAR_GLOBAL_TUM, SCANS_BODY_GLOBAL_TUM, LOOPS_CSV = (
+    "scans_lidar_global.tum",
+    "scans_body_global.tum",
+    "loops.csv",
+)
+#: a candidate is at least this many submap lengths back along the path (its submap shares no scan)
+MIN_LOOP_TRAVEL_FACTOR = 2.0
+#: the search radius grows by this fraction of the path between query and candidate (odometry drift)
+SEARCH_DRIFT = 0.005
+#: coarse to fine: the registration's sigma (correspondences within 3 sigma) at each stage, m
+STAGE_SIGMAS_M = (3.0, 1.0, 0.3)
+#: the ambiguity check's starts: this far along each horizontal axis of the found pose, m
+AMBIGUITY_OFFSET_M = 4.0
+#: and turned by this much about the vertical, rad (10 deg)
+AMBIGUITY_YAW_RAD = math.radians(10.0)
+#: overlap: cells of this many export resolutions
+OVERLAP_CELL_FACTOR = 2.0
+#: standard deviations of an accepted loop edge (translation m, rotation rad)
+LOOP_SIGMA = (0.05, math.radians(0.2))
+NS_PER_S = 1e9
+
+
+@dataclass
+class Keyframe:
+    """A pose-graph node: the odometry's LiDAR pose at its first scan, where it lies along the
+    path, its segment's points (its frame) and its scans' poses relative to it."""
+
+    T_odom: np.ndarray
+    path_m: float
+    stamp_ns: int
+    scans: list[tuple[int, np.ndarray]] = field(default_factory=list)
+    points: np.ndarray | None = None  # (N, 3) float32 once the segment is complete
+    export: Any = None  # the segment under construction (_core.MapExport)
+
+
+@dataclass
+class LoopRecord:
+    """One verified candidate (a row of loops.csv)."""
+
+    query: int
+    match: int
+    query_stamp_ns: int
+    match_stamp_ns: int
+    distance_m: float  # between their global positions before the loop
+    overlap: float
+    correction_m: float  # the verified pose against the graph's guess
+    correction_deg: float
+    ambiguity_m: float  # largest disagreement of the ambiguity check's starts
+    accepted: bool
+    reason: str  # why it was refused ('' when accepted)
+    time_s: float
+    T_match_query: np.ndarray = field(default=None, repr=False)  # the registration's result (not in loops.csv)
+
+
+#: the columns of loops.csv
+LOOPS_CSV_COLUMNS = [name for name in LoopRecord.__dataclass_fields__ if name != "T_match_query"]
+
+
+def _se3(m: np.ndarray) -> Any:
+    return _core.SE3.from_matrix(np.asarray(m, dtype=np.float64))
+
+
+def _rotation_deg(m: np.ndarray) -> float:
+    c = (np.trace(m[:3, :3]) - 1.0) / 2.0
+    return math.degrees(math.acos(max(-1.0, min(1.0, c))))
+
+
+def _transform(points: np.ndarray, T: np.ndarray) -> np.ndarray:
+    return (points @ T[:3, :3].T.astype(np.float32)) + T[:3, 3].astype(np.float32)
+
+
+def _cell_keys(points: np.ndarray, cell_m: float) -> np.ndarray:
+    """One int64 per cell of cell_m (21 bits an axis, as the voxel keys)."""
+    k = np.floor(points / cell_m).astype(np.int64) + (1 << 20)
+    return (k[:, 0] << 42) | (k[:, 1] << 21) | k[:, 2]
+
+
+def _yaw_offset(dx: float, dy: float, yaw: float) -> np.ndarray:
+    c, s = math.cos(yaw), math.sin(yaw)
+    m = np.eye(4)
+    m[:2, :2] = [[c, -s], [s, c]]
+    m[:2, 3] = [dx, dy]
+    return m
+
+
+class LoopClosure:
+    """Keyframes, loop detection and verification, and the pose graph of one run."""
+
+    def __init__(self, config: Any, T_imu_lidar: Any):
+        self.config = config
+        self.T_lidar_imu = np.linalg.inv(T_imu_lidar.matrix())
+        self.keyframe_distance_m = config.get("loop.keyframe_distance_m")
+        self.submap_length_m = config.get("loop.submap_length_m")
+        self.search_radius_m = config.get("loop.search_radius_m")
+        self.min_overlap = config.get("loop.min_overlap")
+        self.max_ambiguity_m = config.get("loop.max_ambiguity_m")
+        self.graph = PoseGraph()
+        self.keyframes: list[Keyframe] = []
+        self.records: list[LoopRecord] = []
+        self.resolution_m: float | None = None
+        self.path_m = 0.0
+        self.last_position: np.ndarray | None = None
+        self.quiet_until_m = -math.inf  # no search before this path length (after an accepted loop)
+        self.verify_s = 0.0
+
+    # ---- keyframes ---------------------------------------------------------------------------
+    def add(self, odo: Any, scan: Any, result: Any) -> None:
+        """A scan whose pose the odometry used (FrameResult result, the LiDAR pose at its end)."""
+        T = result.pose.matrix()
+        if self.last_position is not None:
+            self.path_m += float(np.linalg.norm(T[:3, 3] - self.last_position))
+        self.last_position = T[:3, 3].copy()
+        if self.resolution_m is None:
+            self.resolution_m = _core.export_resolution_m(odo.effective_config)
+        kf = self.keyframes[-1] if self.keyframes else None
+        if kf is None or np.linalg.norm(T[:3, 3] - kf.T_odom[:3, 3]) > self.keyframe_distance_m:
+            kf = self.start_keyframe(odo, T, result.stamp_ns)
+        T_kf_lidar = np.linalg.inv(kf.T_odom) @ T
+        kf.export.add(scan, result, _se3(T_kf_lidar))
+        kf.scans.append((result.stamp_ns, T_kf_lidar))
+
+    def start_keyframe(self, odo: Any, T: np.ndarray, stamp_ns: int) -> Keyframe:
+        """Closes the current keyframe's segment (and searches for its loop), then starts one at T."""
+        if self.keyframes:
+            self.close_segment()
+        previous = self.keyframes[-1] if self.keyframes else None
+        kf = Keyframe(T, self.path_m, stamp_ns)
+        kf.export = _core.MapExport(self.resolution_m, odo.effective_config, "")
+        self.keyframes.append(kf)
+        stats = odo.fusion_stats
+        up = np.asarray(stats.up_map) if stats is not None and stats.initialization.initialized else None
+        self.graph.add_keyframe(T, self.path_m - previous.path_m if previous else 0.0, up)
+        return kf
+
+    def close_segment(self) -> None:
+        kf = self.keyframes[-1]
+        kf.points = np.asarray(kf.export.points().points, dtype=np.float32)
+        kf.export = None
+        self.search(len(self.keyframes) - 1)
+
+    def submap(self, k: int, first: int, last: int) -> np.ndarray:
+        """Segments first..last (complete ones) in keyframe k's frame (its global estimate)."""
+        G_k_inv = np.linalg.inv(self.graph.pose(k))
+        parts = []
+        for j in range(max(0, first), min(last, len(self.keyframes) - 1) + 1):
+            kf = self.keyframes[j]
+            if kf.points is None or len(kf.points) == 0:
+                continue
+            parts.append(_transform(kf.points, G_k_inv @ self.graph.pose(j)))
+        return np.concatenate(parts) if parts else np.zeros((0, 3), np.float32)
+
+    def segments_back(self, k: int) -> int:
+        """The first keyframe of k's submap: the segments within submap_length_m of path before k."""
+        j = k
+        while j > 0 and self.keyframes[k].path_m - self.keyframes[j - 1].path_m <= self.submap_length_m:
+            j -= 1
+        return j
+
+    # ---- detection and verification ----------------------------------------------------------
+    def search(self, k: int) -> None:
+        """Looks for the place keyframe k revisits and verifies the nearest candidate."""
+        query = self.keyframes[k]
+        if query.path_m < self.quiet_until_m:
+            return
+        G = self.graph.poses()
+        best, best_d = None, math.inf
+        for j in range(k):
+            travel = query.path_m - self.keyframes[j].path_m
+            if travel < MIN_LOOP_TRAVEL_FACTOR * self.submap_length_m:
+                break
+            d = float(np.linalg.norm(G[k][:3, 3] - G[j][:3, 3]))
+            if d <= self.search_radius_m + SEARCH_DRIFT * travel and d < best_d:
+                best, best_d = j, d
+        if best is not None:
+            self.verify(k, best, best_d)
+
+    def register(self, source: np.ndarray, target: np.ndarray, guess: np.ndarray) -> np.ndarray:
+        """T_target_source by GICP, coarse to fine from guess."""
+        src, tgt = farlio.Scan(source), farlio.Scan(target)
+        T = guess
+        for sigma in STAGE_SIGMAS_M:
+            c = _core.Config(self.config)
+            c.set("threshold.initial_threshold_m", sigma)
+            T = _core.register_pair(src, tgt, _se3(T), c).pose.matrix()
+        return T
+
+    def check(self, k: int, j: int, guess: np.ndarray) -> tuple[np.ndarray, float, float, str]:
+        """Registers keyframe k's submap onto j's neighbourhood from guess (T_j_k): the pose found,
+        the overlap, the ambiguity (m) and why it is refused ('' when it is a loop)."""
+        source = self.submap(k, self.segments_back(k), k)
+        j_first = self.segments_back(j)
+        target = self.submap(j, j_first, j + (j - j_first))
+        T = self.register(source, target, guess)
+        if not np.all(np.isfinite(T)):
+            return T, 0.0, math.nan, "registration failed"
+        overlap = self.overlap(_transform(source, T), target)
+        if overlap < self.min_overlap:
+            return T, overlap, math.nan, f"overlap {overlap:.2f} < loop.min_overlap {self.min_overlap}"
+        ambiguity = self.ambiguity(source, target, T)
+        if ambiguity > self.max_ambiguity_m:
+            return T, overlap, ambiguity, f"ambiguous: starts nearby end {ambiguity:.2f} m apart"
+        return T, overlap, ambiguity, ""
+
+    def verify(self, k: int, j: int, distance_m: float) -> None:
+        """Checks the candidate from the graph's guess; a loop edge when it passes."""
+        start = time.perf_counter()
+        guess = np.linalg.inv(self.graph.pose(j)) @ self.graph.pose(k)
+        T, overlap, ambiguity, reason = self.check(k, j, guess)
+        if not reason:
+            cov = np.diag([LOOP_SIGMA[1] ** 2] * 3 + [LOOP_SIGMA[0] ** 2] * 3)
+            self.graph.add_loop(j, k, T, cov)
+            self.quiet_until_m = self.keyframes[k].path_m + self.submap_length_m
+        elapsed = time.perf_counter() - start
+        self.verify_s += elapsed
+        correction = np.linalg.inv(guess) @ T if np.all(np.isfinite(T)) else np.full((4, 4), np.nan)
+        self.records.append(
+            LoopRecord(
+                k,
+                j,
+                self.keyframes[k].stamp_ns,
+                self.keyframes[j].stamp_ns,
+                distance_m,
+                overlap,
+                float(np.linalg.norm(correction[:3, 3])),
+                _rotation_deg(correction) if np.all(np.isfinite(correction)) else math.nan,
+                ambiguity,
+                not reason,
+                reason,
+                elapsed,
+                T,
+            )
+        )
+
+    def overlap(self, source_in_target: np.ndarray, target: np.ndarray) -> float:
+        """The fraction of the source's cells that the target occupies too."""
+        if len(source_in_target) == 0:
+            return 0.0
+        cell = OVERLAP_CELL_FACTOR * self.resolution_m
+        s = np.unique(_cell_keys(source_in_target, cell))
+        return float(np.isin(s, np.unique(_cell_keys(target, cell))).mean())
+
+    def ambiguity(self, source: np.ndarray, target: np.ndarray, T: np.ndarray) -> float:
+        """The largest distance from T of the registrations started around it."""
+        worst = 0.0
+        for dx, dy, yaw in (
+            (AMBIGUITY_OFFSET_M, 0.0, AMBIGUITY_YAW_RAD),
+            (-AMBIGUITY_OFFSET_M, 0.0, -AMBIGUITY_YAW_RAD),
+            (0.0, AMBIGUITY_OFFSET_M, -AMBIGUITY_YAW_RAD),
+            (0.0, -AMBIGUITY_OFFSET_M, AMBIGUITY_YAW_RAD),
+        ):
+            Ti = self.register(source, target, T @ _yaw_offset(dx, dy, yaw))
+            worst = max(worst, float(np.linalg.norm(Ti[:3, 3] - T[:3, 3])) if np.all(np.isfinite(Ti)) else math.inf)
+        return worst
+
+    # ---- results ------------------------------------------------------------------------------
+    def finish(self) -> None:
+        """Closes the last segment (and searches for its loop)."""
+        if self.keyframes and self.keyframes[-1].export is not None:
+            self.close_segment()
+
+    def global_lidar_poses(self) -> list[tuple[int, np.ndarray]]:
+        """Every scan's LiDAR pose in the global frame (its keyframe's optimised pose)."""
+        out = []
+        for k, kf in enumerate(self.keyframes):
+            G = self.graph.pose(k)
+            out.extend((stamp, G @ T_kf) for stamp, T_kf in kf.scans)
+        return out
+
+    def global_points(self) -> np.ndarray:
+        """Every segment's points at its keyframe's global pose (the rebuilt map's input)."""
+        parts = [
+            _transform(kf.points, self.graph.pose(k)) for k, kf in enumerate(self.keyframes) if kf.points is not None
+        ]
+        return np.concatenate(parts) if parts else np.zeros((0, 3), np.float32)
+
+    def write(self, out_dir: Path) -> dict[str, Any]:
+        """scans_lidar_global.tum, scans_body_global.tum, loops.csv; returns the summary's entry."""
+        lidar = _core.io.TrajectoryWriter(Path(out_dir) / SCANS_LIDAR_GLOBAL_TUM)
+        body = _core.io.TrajectoryWriter(Path(out_dir) / SCANS_BODY_GLOBAL_TUM)
+        for stamp, T in self.global_lidar_poses():
+            lidar.append(stamp, _se3(T))
+            body.append(stamp, _se3(T @ self.T_lidar_imu))
+        with open(Path(out_dir) / LOOPS_CSV, "w", newline="") as f:
+            w = csv.writer(f)
+            w.writerow(LOOPS_CSV_COLUMNS)
+            for r in self.records:
+                w.writerow([getattr(r, name) for name in LOOPS_CSV_COLUMNS])
+        accepted = [r for r in self.records if r.accepted]
+        return {
+            "keyframes": len(self.keyframes),
+            "path_m": self.path_m,
+            "candidates": len(self.records),
+            "accepted": len(accepted),
+            "verify_s": self.verify_s,
+            "largest_correction_m": max((r.correction_m for r in accepted), default=0.0),
+        }
