@@ -28,6 +28,7 @@ import csv
 import json
 import tempfile
 from pathlib import Path
+from typing import Any
 
 import farlio
 import numpy as np
@@ -36,6 +37,7 @@ from farlio.config import load_config
 from farlio.datasets.base import Dataset
 from farlio.mapping import MAP_PCD, MapOptions
 from farlio.runner import SCANS_BODY_TUM, replay_options, run_dataset
+from farlio.simulation import make_config
 
 #: (map duration, pass duration) in seconds
 DURATIONS_S = {"urban": (60.0, 60.0), "handheld": (60.0, 60.0), "racetrack": (85.0, 165.0), "tunnel": (45.0, 45.0)}
@@ -46,10 +48,9 @@ FIXED_LATENCY_S = 0.02
 class GeneratedDataset(Dataset):
     """A generated sequence served from memory, scan by scan, with its ground truth as TUM files."""
 
-    def __init__(self, profile: str, seed: int, duration_s: float, work: Path):
-        cfg = _core.sim.default_config(profile)
-        cfg.seed, cfg.duration_s = seed, duration_s
-        self.gen = _core.sim.SequenceGenerator(cfg)
+    def __init__(self, profile: str, seed: int, duration_s: float, work: Path, **sim: Any):
+        """sim: further make_config arguments (lidar, lidar_rate_hz, ...)."""
+        self.gen = _core.sim.SequenceGenerator(make_config(profile, seed=seed, duration_s=duration_s, **sim))
         self.path = work / f"{profile}-{seed}"
         self.path.mkdir(parents=True, exist_ok=True)
         self.gt_scans = self.path / "groundtruth_scans.tum"

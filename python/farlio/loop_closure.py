@@ -22,14 +22,17 @@ After a loop is accepted the next loop.submap_length_m of travel is not searched
 submap is enough to hold the graph, and verification is the expensive step).
 
 Outputs (write): scans_lidar_global.tum and scans_body_global.tum, every scan's pose corrected
-through its keyframe, and loops.csv, every verified candidate with its figures and the reason it
-was refused. The odometry's own outputs are unchanged."""
+through its keyframe, and loops.csv, every verified candidate with its figures, the reason it was
+refused, and the registration's pose of the query keyframe in the match's frame (tx ty tz qx qy qz
+qw). The odometry's own outputs are unchanged."""
 
 from __future__ import annotations
 
 import csv
 import math
+import os
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -92,11 +95,20 @@ class LoopRecord:
     accepted: bool
     reason: str  # why it was refused ('' when accepted)
     time_s: float
-    T_match_query: np.ndarray = field(default=None, repr=False)  # the registration's result (not in loops.csv)
+    T_match_query: np.ndarray = field(default=None, repr=False)  # the registration's result
+
+    def row(self) -> list[Any]:
+        """The loops.csv row: the fields, then T_match_query as tx ty tz qx qy qz qw."""
+        T = self.T_match_query
+        pose = [math.nan] * 7
+        if T is not None and np.all(np.isfinite(T)):
+            pose = [*T[:3, 3], *_core.SE3.from_matrix(T).quaternion_xyzw]
+        return [getattr(self, name) for name in LOOPS_CSV_FIELDS] + pose
 
 
 #: the columns of loops.csv
-LOOPS_CSV_COLUMNS = [name for name in LoopRecord.__dataclass_fields__ if name != "T_match_query"]
+LOOPS_CSV_FIELDS = [name for name in LoopRecord.__dataclass_fields__ if name != "T_match_query"]
+LOOPS_CSV_COLUMNS = LOOPS_CSV_FIELDS + ["tx", "ty", "tz", "qx", "qy", "qz", "qw"]
 
 
 def _se3(m: np.ndarray) -> Any:
@@ -138,6 +150,15 @@ class LoopClosure:
         self.min_overlap = config.get("loop.min_overlap")
         self.max_ambiguity_m = config.get("loop.max_ambiguity_m")
         self.graph = PoseGraph()
+        # one thread per registration (submaps are small: 5 ms on one thread, 12 ms on two), the
+        # ambiguity test's registrations side by side on the run's threads
+        self.stage_configs = []
+        for sigma in STAGE_SIGMAS_M:
+            c = _core.Config(config)
+            c.set("num_threads", 1)
+            c.set("threshold.initial_threshold_m", sigma)
+            self.stage_configs.append(c)
+        self.workers = config.get("num_threads") or os.cpu_count() or 1
         self.keyframes: list[Keyframe] = []
         self.records: list[LoopRecord] = []
         self.resolution_m: float | None = None
@@ -145,6 +166,7 @@ class LoopClosure:
         self.last_position: np.ndarray | None = None
         self.quiet_until_m = -math.inf  # no search before this path length (after an accepted loop)
         self.verify_s = 0.0
+        self.graph_s = 0.0  # time in the pose graph's updates (iSAM2)
 
     # ---- keyframes ---------------------------------------------------------------------------
     def add(self, odo: Any, scan: Any, result: Any) -> None:
@@ -170,9 +192,9 @@ class LoopClosure:
         kf = Keyframe(T, self.path_m, stamp_ns)
         kf.export = _core.MapExport(self.resolution_m, odo.effective_config, "")
         self.keyframes.append(kf)
-        stats = odo.fusion_stats
-        up = np.asarray(stats.up_map) if stats is not None and stats.initialization.initialized else None
-        self.graph.add_keyframe(T, self.path_m - previous.path_m if previous else 0.0, up)
+        start = time.perf_counter()
+        self.graph.add_keyframe(T, self.path_m - previous.path_m if previous else 0.0)
+        self.graph_s += time.perf_counter() - start
         return kf
 
     def close_segment(self) -> None:
@@ -221,9 +243,7 @@ class LoopClosure:
         """T_target_source by GICP, coarse to fine from guess."""
         src, tgt = farlio.Scan(source), farlio.Scan(target)
         T = guess
-        for sigma in STAGE_SIGMAS_M:
-            c = _core.Config(self.config)
-            c.set("threshold.initial_threshold_m", sigma)
+        for c in self.stage_configs:
             T = _core.register_pair(src, tgt, _se3(T), c).pose.matrix()
         return T
 
@@ -251,7 +271,9 @@ class LoopClosure:
         T, overlap, ambiguity, reason = self.check(k, j, guess)
         if not reason:
             cov = np.diag([LOOP_SIGMA[1] ** 2] * 3 + [LOOP_SIGMA[0] ** 2] * 3)
+            graph_start = time.perf_counter()
             self.graph.add_loop(j, k, T, cov)
+            self.graph_s += time.perf_counter() - graph_start
             self.quiet_until_m = self.keyframes[k].path_m + self.submap_length_m
         elapsed = time.perf_counter() - start
         self.verify_s += elapsed
@@ -284,14 +306,19 @@ class LoopClosure:
 
     def ambiguity(self, source: np.ndarray, target: np.ndarray, T: np.ndarray) -> float:
         """The largest distance from T of the registrations started around it."""
+        starts = [
+            T @ _yaw_offset(dx, dy, yaw)
+            for dx, dy, yaw in (
+                (AMBIGUITY_OFFSET_M, 0.0, AMBIGUITY_YAW_RAD),
+                (-AMBIGUITY_OFFSET_M, 0.0, -AMBIGUITY_YAW_RAD),
+                (0.0, AMBIGUITY_OFFSET_M, -AMBIGUITY_YAW_RAD),
+                (0.0, -AMBIGUITY_OFFSET_M, AMBIGUITY_YAW_RAD),
+            )
+        ]
+        with ThreadPoolExecutor(self.workers) as pool:  # register_pair releases the GIL
+            ends = list(pool.map(lambda start: self.register(source, target, start), starts))
         worst = 0.0
-        for dx, dy, yaw in (
-            (AMBIGUITY_OFFSET_M, 0.0, AMBIGUITY_YAW_RAD),
-            (-AMBIGUITY_OFFSET_M, 0.0, -AMBIGUITY_YAW_RAD),
-            (0.0, AMBIGUITY_OFFSET_M, -AMBIGUITY_YAW_RAD),
-            (0.0, -AMBIGUITY_OFFSET_M, AMBIGUITY_YAW_RAD),
-        ):
-            Ti = self.register(source, target, T @ _yaw_offset(dx, dy, yaw))
+        for Ti in ends:
             worst = max(worst, float(np.linalg.norm(Ti[:3, 3] - T[:3, 3])) if np.all(np.isfinite(Ti)) else math.inf)
         return worst
 
@@ -308,6 +335,11 @@ class LoopClosure:
             G = self.graph.pose(k)
             out.extend((stamp, G @ T_kf) for stamp, T_kf in kf.scans)
         return out
+
+    def accepted_loop_ends(self) -> np.ndarray:
+        """(M, 2, 2): the global xy of both keyframes of every accepted loop (map_global.png)."""
+        ends = [[self.graph.pose(r.query)[:2, 3], self.graph.pose(r.match)[:2, 3]] for r in self.records if r.accepted]
+        return np.asarray(ends, dtype=np.float64).reshape(-1, 2, 2)
 
     def global_points(self) -> np.ndarray:
         """Every segment's points at its keyframe's global pose (the rebuilt map's input)."""
@@ -327,7 +359,7 @@ class LoopClosure:
             w = csv.writer(f)
             w.writerow(LOOPS_CSV_COLUMNS)
             for r in self.records:
-                w.writerow([getattr(r, name) for name in LOOPS_CSV_COLUMNS])
+                w.writerow(r.row())
         accepted = [r for r in self.records if r.accepted]
         return {
             "keyframes": len(self.keyframes),
@@ -335,5 +367,6 @@ class LoopClosure:
             "candidates": len(self.records),
             "accepted": len(accepted),
             "verify_s": self.verify_s,
+            "graph_s": self.graph_s,
             "largest_correction_m": max((r.correction_m for r in accepted), default=0.0),
         }

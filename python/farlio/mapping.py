@@ -133,8 +133,8 @@ def downsample(points: np.ndarray, resolution_m: float) -> np.ndarray:
 
 
 def write_global_map(loops: Any, resolution_m: float, out_dir: Path, trajectory: Path, plot: bool) -> dict[str, Any]:
-    """map_global.pcd, map_global.ply (and map_global.png): every keyframe's segment at its
-    optimised pose, one centroid per cell; returns the summary's entry."""
+    """map_global.pcd, map_global.ply (and map_global.png, with the accepted loops): every
+    keyframe's segment at its optimised pose, one centroid per cell; returns the summary's entry."""
     points = downsample(loops.global_points(), resolution_m)
     cloud = farlio.Scan(points)
     _core.io.write_pcd(out_dir / MAP_GLOBAL_PCD, cloud)
@@ -142,5 +142,5 @@ def write_global_map(loops: Any, resolution_m: float, out_dir: Path, trajectory:
     if plot:
         from .plots import plot_map
 
-        plot_map(points, trajectory, out_dir / MAP_GLOBAL_PNG)
+        plot_map(points, trajectory, out_dir / MAP_GLOBAL_PNG, loops.accepted_loop_ends())
     return {"points": len(points), "resolution_m": resolution_m}

@@ -56,9 +56,10 @@ def plot_trajectory(estimate: Path, path: Path, groundtruth: Path | None = None)
     plt.close(fig)
 
 
-def plot_map(points: np.ndarray, trajectory: Path, path: Path) -> None:
+def plot_map(points: np.ndarray, trajectory: Path, path: Path, loops: np.ndarray | None = None) -> None:
     """map.png: the map's points (N, 3, world frame) from above coloured by height, with the
-    trajectory (a TUM file in the same frame) drawn on top."""
+    trajectory (a TUM file in the same frame) drawn on top, and loops ((M, 2, 2): the xy of both
+    ends of each accepted loop) as lines between the places they join."""
     plt = _pyplot()
     pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     if len(pts) > MAP_PNG_MAX_POINTS:
@@ -84,7 +85,11 @@ def plot_map(points: np.ndarray, trajectory: Path, path: Path) -> None:
         if len(poses):
             ax.plot(poses[:, 0, 3], poses[:, 1, 3], "r-", linewidth=1.2, label="trajectory")
             ax.plot(poses[0, 0, 3], poses[0, 1, 3], "ro", markersize=4)
-            ax.legend(loc="upper right")
+    if loops is not None and len(loops):
+        for i, (a, b) in enumerate(np.asarray(loops)):
+            ax.plot([a[0], b[0]], [a[1], b[1]], "m-o", markersize=3, linewidth=1.5, label="loop" if i == 0 else None)
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(loc="upper right")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     ax.set_aspect("equal", adjustable="box")  # the axes fit the map, not the square figure

@@ -10,7 +10,6 @@ verification let through wrongly pulls the graph far less than its square error 
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
@@ -26,9 +25,6 @@ ODOMETRY_MIN_SIGMA = (0.01, 1e-3)
 ANCHOR_SIGMA = 1e-6
 #: Cauchy kernel of the loop edges, in standard deviations of their registration
 LOOP_KERNEL_SCALE = 1.0
-#: with an IMU, each keyframe's tilt (its up direction, from the filter's gravity) is held to this
-#: (rad, 0.2 deg): a loop then corrects drift in position and heading, not by tilting whole laps
-ATTITUDE_SIGMA_RAD = math.radians(0.2)
 
 
 def import_gtsam() -> Any:
@@ -58,10 +54,9 @@ class PoseGraph:
     def __len__(self) -> int:
         return len(self.odometry)
 
-    def add_keyframe(self, T_odom: np.ndarray, travelled_m: float, up: np.ndarray | None = None) -> int:
+    def add_keyframe(self, T_odom: np.ndarray, travelled_m: float) -> int:
         """A keyframe at the odometry's pose T_odom, travelled_m after the previous one; returns its
-        index. Its global pose starts as the previous global pose moved by the odometry's step. up:
-        the odometry frame's up direction (LIO: against gravity), which the keyframe's tilt keeps."""
+        index. Its global pose starts as the previous global pose moved by the odometry's step."""
         g = self.gtsam
         k = len(self.odometry)
         graph, values = g.NonlinearFactorGraph(), g.Values()
@@ -77,11 +72,6 @@ class PoseGraph:
             )
             graph.add(g.BetweenFactorPose3(k - 1, k, g.Pose3(step), g.noiseModel.Diagonal.Sigmas(sigma)))
             values.insert(k, g.Pose3(self.pose(k - 1) @ step))
-        if up is not None:
-            up = np.asarray(up, dtype=np.float64)
-            body_up = T_odom[:3, :3].T @ up
-            model = g.noiseModel.Isotropic.Sigma(2, ATTITUDE_SIGMA_RAD)
-            graph.add(g.AttitudeFactorPose3(k, g.Unit3(up), model, g.Unit3(body_up)))
         self.odometry.append(np.asarray(T_odom, dtype=np.float64))
         self.isam.update(graph, values)
         self.estimate = self.isam.calculateEstimate()

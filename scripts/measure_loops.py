@@ -1,0 +1,124 @@
+#!/usr/bin/env python3
+"""Loop closure against the ground truth: `farlio run --loop-closure` (run_dataset, scans
+generated in memory, fixed 20 ms replay latency) per seed, printing
+
+  odometry / global APE   aligned translation RMSE of scans_body.tum / scans_body_global.tum (m)
+  accepted / verified     loops accepted and candidates verified (loops.csv)
+  precision               accepted loops whose registered pose (loops.csv tx..qw) is within
+                          CORRECT_LOOP_M and CORRECT_LOOP_DEG of the ground truth's relative pose
+  recall                  the revisited path (scans within REVISIT_M of where the ground truth was
+                          at least 2 submap lengths earlier) that lies within loop.submap_length_m
+                          of an accepted loop's query keyframe
+  verify s, graph s        time spent verifying candidates, and in the pose graph's updates (iSAM2)
+
+Usage: python scripts/measure_loops.py [--profile racetrack] [--duration 165] [--seeds 1 2 3]
+       [--lidar MODEL] [--lidar-rate HZ] [--set name=value ...] [--out DIR]
+The racetrack's first lap takes 82.7 s: 165 s is two laps (8.3 km).
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import math
+import tempfile
+from pathlib import Path
+
+import numpy as np
+from farlio.config import load_config
+from farlio.loop_closure import LOOPS_CSV, MIN_LOOP_TRAVEL_FACTOR
+from farlio.mapping import MapOptions
+from farlio.runner import replay_options, run_dataset
+from measure_maps import FIXED_LATENCY_S, GeneratedDataset
+
+CORRECT_LOOP_M, CORRECT_LOOP_DEG = 0.5, 1.0
+REVISIT_M = 5.0
+
+
+def gt_lidar(gen) -> tuple[np.ndarray, list[np.ndarray]]:
+    T_il = gen.T_imu_lidar().matrix()
+    gt = gen.groundtruth_scans()
+    return np.array([s for s, _ in gt]), [p.matrix() @ T_il for _, p in gt]
+
+
+def precision_recall(gen, loops_csv: Path, submap_length_m: float) -> tuple[float, float]:
+    stamps, poses = gt_lidar(gen)
+
+    def at(stamp: int) -> np.ndarray:
+        return poses[min(int(np.searchsorted(stamps, stamp)), len(poses) - 1)]
+
+    with open(loops_csv) as f:
+        accepted = [r for r in csv.DictReader(f) if r["accepted"] == "True"]
+    correct = 0
+    for r in accepted:
+        m = np.eye(4)
+        m[:3, :3] = _quat([float(r[k]) for k in ("qx", "qy", "qz", "qw")])
+        m[:3, 3] = [float(r[k]) for k in ("tx", "ty", "tz")]
+        true = np.linalg.inv(at(int(r["match_stamp_ns"]))) @ at(int(r["query_stamp_ns"]))
+        d = np.linalg.inv(true) @ m
+        deg = math.degrees(math.acos(min(1.0, (np.trace(d[:3, :3]) - 1.0) / 2.0)))
+        correct += int(np.linalg.norm(d[:3, 3]) < CORRECT_LOOP_M and deg < CORRECT_LOOP_DEG)
+    P = np.array([p[:3, 3] for p in poses])
+    path = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(P, axis=0), axis=1))]
+    min_travel = MIN_LOOP_TRAVEL_FACTOR * submap_length_m
+    revisit = np.zeros(len(P), bool)
+    for i in range(len(P)):
+        earlier = path < path[i] - min_travel
+        revisit[i] = earlier.any() and np.min(np.linalg.norm(P[earlier] - P[i], axis=1)) < REVISIT_M
+    query_path = [path[min(int(np.searchsorted(stamps, int(r["query_stamp_ns"]))), len(P) - 1)] for r in accepted]
+    covered = np.array([any(abs(path[i] - q) <= submap_length_m for q in query_path) for i in np.flatnonzero(revisit)])
+    precision = correct / len(accepted) if accepted else math.nan
+    recall = float(covered.mean()) if len(covered) else math.nan
+    return precision, recall
+
+
+def _quat(q: list[float]) -> np.ndarray:
+    x, y, z, w = q
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--profile", default="racetrack")
+    ap.add_argument("--duration", type=float, default=165.0)
+    ap.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
+    ap.add_argument("--lidar", default="profile")
+    ap.add_argument("--lidar-rate", type=float, default=None)
+    ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE")
+    ap.add_argument("--out", type=Path, default=None)
+    args = ap.parse_args()
+    out = args.out or Path(tempfile.mkdtemp(prefix="measure_loops_"))
+    config = load_config(None, args.set)
+    print("seed | odometry APE m | global APE m | accepted / verified | precision | recall | verify s | graph s")
+    for seed in args.seeds:
+        ds = GeneratedDataset(args.profile, seed, args.duration, out, lidar=args.lidar, lidar_rate_hz=args.lidar_rate)
+        s = run_dataset(
+            ds,
+            out / f"run-{seed}",
+            config,
+            maps=MapOptions(loop_closure=True),
+            progress=False,
+            plot=False,
+            options=replay_options("fixed", FIXED_LATENCY_S),
+        )
+        lc = s["loop_closure"]
+        precision, recall = precision_recall(
+            ds.gen, out / f"run-{seed}" / LOOPS_CSV, config.get("loop.submap_length_m")
+        )
+        print(
+            f"{seed} | {s['accuracy']['ape']['translation_m']['rmse']:.3f} | "
+            f"{s['accuracy_global']['ape']['translation_m']['rmse']:.3f} | {lc['accepted']} / {lc['candidates']} | "
+            f"{precision:.2f} | {recall:.2f} | {lc['verify_s']:.1f} | {lc['graph_s']:.2f}",
+            flush=True,
+        )
+    print(f"outputs in {out}")
+
+
+if __name__ == "__main__":
+    main()
