@@ -19,7 +19,8 @@ loop.submap_length_m of path before it. When a keyframe's segment is complete:
 3. the pose graph (pose_graph.py) gets the loop edge and is optimised (iSAM2).
 
 After a loop is accepted the next loop.submap_length_m of travel is not searched (one loop per
-submap is enough to hold the graph, and verification is the expensive step).
+submap is enough to hold the graph, and verification is the expensive step), after a candidate
+refused as ambiguous the next half submap length.
 
 Outputs (write): scans_lidar_global.tum and scans_body_global.tum, every scan's pose corrected
 through its keyframe, and loops.csv, every verified candidate with its figures, the reason it was
@@ -53,6 +54,9 @@ SCANS_LIDAR_GLOBAL_TUM, SCANS_BODY_GLOBAL_TUM, LOOPS_CSV = (
 MIN_LOOP_TRAVEL_FACTOR = 2.0
 #: the search radius grows by this fraction of the path between query and candidate (odometry drift)
 SEARCH_DRIFT = 0.005
+#: after a candidate refused as ambiguous, the search waits this fraction of a submap length: the
+#: next keyframes' submaps share most of its scans (a straight stays ambiguous for its length)
+RETRY_AFTER_AMBIGUOUS = 0.5
 #: coarse to fine: the registration's sigma (correspondences within 3 sigma) at each stage, m
 STAGE_SIGMAS_M = (3.0, 1.0, 0.3)
 #: the ambiguity check's starts: this far along each horizontal axis of the found pose, m
@@ -63,7 +67,7 @@ AMBIGUITY_YAW_RAD = math.radians(10.0)
 OVERLAP_CELL_FACTOR = 2.0
 #: standard deviations of an accepted loop edge (translation m, rotation rad)
 LOOP_SIGMA = (0.05, math.radians(0.2))
-NS_PER_S = 1e9
+AMBIGUOUS = "ambiguous"
 
 
 @dataclass
@@ -261,7 +265,7 @@ class LoopClosure:
             return T, overlap, math.nan, f"overlap {overlap:.2f} < loop.min_overlap {self.min_overlap}"
         ambiguity = self.ambiguity(source, target, T)
         if ambiguity > self.max_ambiguity_m:
-            return T, overlap, ambiguity, f"ambiguous: starts nearby end {ambiguity:.2f} m apart"
+            return T, overlap, ambiguity, f"{AMBIGUOUS}: starts nearby end {ambiguity:.2f} m apart"
         return T, overlap, ambiguity, ""
 
     def verify(self, k: int, j: int, distance_m: float) -> None:
@@ -269,6 +273,8 @@ class LoopClosure:
         start = time.perf_counter()
         guess = np.linalg.inv(self.graph.pose(j)) @ self.graph.pose(k)
         T, overlap, ambiguity, reason = self.check(k, j, guess)
+        if reason.startswith(AMBIGUOUS):
+            self.quiet_until_m = self.keyframes[k].path_m + RETRY_AFTER_AMBIGUOUS * self.submap_length_m
         if not reason:
             cov = np.diag([LOOP_SIGMA[1] ** 2] * 3 + [LOOP_SIGMA[0] ** 2] * 3)
             graph_start = time.perf_counter()
