@@ -11,8 +11,14 @@ generated in memory, fixed 20 ms replay latency) per seed, printing
                           of an accepted loop's query keyframe
   verify s, graph s        time spent verifying candidates, and in the pose graph's updates (iSAM2)
 
+With --handover, instead: keyframes HANDOVER_SEPARATION_M apart along the path (every
+HANDOVER_STRIDE-th keyframe against the first one far enough back) are handed to the verification
+as if they were one place (guess: identity), and each pair's overlap, the distance between the
+ambiguity test's ends and the verdict are printed, with the error of the registered pose against
+the ground truth's relative pose: repeated structure must be refused or found where it truly is.
+
 Usage: python scripts/measure_loops.py [--profile racetrack] [--duration 165] [--seeds 1 2 3]
-       [--lidar MODEL] [--lidar-rate HZ] [--set name=value ...] [--out DIR]
+       [--lidar MODEL] [--lidar-rate HZ] [--set name=value ...] [--out DIR] [--handover]
 The racetrack's first lap takes 82.7 s: 165 s is two laps (8.3 km).
 """
 
@@ -25,14 +31,16 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
+from farlio import _core
 from farlio.config import load_config
-from farlio.loop_closure import LOOPS_CSV, MIN_LOOP_TRAVEL_FACTOR
+from farlio.loop_closure import LOOPS_CSV, MIN_LOOP_TRAVEL_FACTOR, LoopClosure
 from farlio.mapping import MapOptions
 from farlio.runner import replay_options, run_dataset
 from measure_maps import FIXED_LATENCY_S, GeneratedDataset
 
 CORRECT_LOOP_M, CORRECT_LOOP_DEG = 0.5, 1.0
 REVISIT_M = 5.0
+HANDOVER_SEPARATION_M, HANDOVER_STRIDE = (60.0, 200.0), 10
 
 
 def gt_lidar(gen) -> tuple[np.ndarray, list[np.ndarray]]:
@@ -72,6 +80,40 @@ def precision_recall(gen, loops_csv: Path, submap_length_m: float) -> tuple[floa
     return precision, recall
 
 
+def handover(ds: GeneratedDataset, config) -> None:
+    """Different places handed over as one (see the module doc)."""
+    odo = _core.Odometry(
+        config, ds.T_imu_lidar(), ds.gravity_m_s2(), ds.imu(), replay_options("fixed", FIXED_LATENCY_S)
+    )
+    loops = LoopClosure(config, ds.T_imu_lidar())
+    for i in range(len(ds)):
+        scan = ds.scan(i)
+        fr = odo.process(scan)
+        if fr.processed and not fr.scan.failure:
+            loops.add(odo, scan, fr.scan)
+    loops.finish()
+    stamps, poses = gt_lidar(ds.gen)
+
+    def at(stamp: int) -> np.ndarray:
+        return poses[min(int(np.searchsorted(stamps, stamp)), len(poses) - 1)]
+
+    kfs = loops.keyframes
+    print(f"{len(kfs)} keyframes, {sum(r.accepted for r in loops.records)} loops accepted in the run")
+    print("query | match | separation m | overlap | ambiguity m | error vs truth m | verdict")
+    for k in range(0, len(kfs), HANDOVER_STRIDE):
+        far = [j for j in range(k) if HANDOVER_SEPARATION_M[0] <= kfs[k].path_m - kfs[j].path_m]
+        far = [j for j in far if kfs[k].path_m - kfs[j].path_m <= HANDOVER_SEPARATION_M[1]]
+        if not far:
+            continue
+        j = far[-1]
+        T, overlap, ambiguity, reason = loops.check(k, j, np.eye(4))
+        error = np.linalg.norm((np.linalg.inv(np.linalg.inv(at(kfs[j].stamp_ns)) @ at(kfs[k].stamp_ns)) @ T)[:3, 3])
+        print(
+            f"{k} | {j} | {kfs[k].path_m - kfs[j].path_m:.0f} | {overlap:.2f} | {ambiguity:.2f} | {error:.2f} | "
+            f"{reason or 'accepted'}"
+        )
+
+
 def _quat(q: list[float]) -> np.ndarray:
     x, y, z, w = q
     return np.array(
@@ -92,9 +134,19 @@ def main() -> None:
     ap.add_argument("--lidar-rate", type=float, default=None)
     ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE")
     ap.add_argument("--out", type=Path, default=None)
+    ap.add_argument("--handover", action="store_true", help="different places handed over as one (module doc)")
     args = ap.parse_args()
     out = args.out or Path(tempfile.mkdtemp(prefix="measure_loops_"))
     config = load_config(None, args.set)
+    if args.handover:
+        for seed in args.seeds:
+            handover(
+                GeneratedDataset(
+                    args.profile, seed, args.duration, out, lidar=args.lidar, lidar_rate_hz=args.lidar_rate
+                ),
+                config,
+            )
+        return
     print("seed | odometry APE m | global APE m | accepted / verified | precision | recall | verify s | graph s")
     for seed in args.seeds:
         ds = GeneratedDataset(args.profile, seed, args.duration, out, lidar=args.lidar, lidar_rate_hz=args.lidar_rate)

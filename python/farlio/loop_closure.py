@@ -168,7 +168,7 @@ class LoopClosure:
         self.resolution_m: float | None = None
         self.path_m = 0.0
         self.last_position: np.ndarray | None = None
-        self.quiet_until_m = -math.inf  # no search before this path length (after an accepted loop)
+        self.quiet_until_m = -math.inf  # no search before this path length (after a loop, or an ambiguous one)
         self.verify_s = 0.0
         self.graph_s = 0.0  # time in the pose graph's updates (iSAM2)
 
