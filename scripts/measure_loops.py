@@ -37,6 +37,7 @@ from farlio.loop_closure import LOOPS_CSV, MIN_LOOP_TRAVEL_FACTOR, LoopClosure
 from farlio.mapping import MapOptions
 from farlio.runner import replay_options, run_dataset
 from measure_maps import FIXED_LATENCY_S, GeneratedDataset
+from scipy.spatial.transform import Rotation  # xyzw quaternions, as loops.csv
 
 CORRECT_LOOP_M, CORRECT_LOOP_DEG = 0.5, 1.0
 REVISIT_M = 5.0
@@ -60,12 +61,12 @@ def precision_recall(gen, loops_csv: Path, submap_length_m: float) -> tuple[floa
     correct = 0
     for r in accepted:
         m = np.eye(4)
-        m[:3, :3] = _quat([float(r[k]) for k in ("qx", "qy", "qz", "qw")])
+        m[:3, :3] = Rotation.from_quat([float(r[k]) for k in ("qx", "qy", "qz", "qw")]).as_matrix()
         m[:3, 3] = [float(r[k]) for k in ("tx", "ty", "tz")]
         true = np.linalg.inv(at(int(r["match_stamp_ns"]))) @ at(int(r["query_stamp_ns"]))
-        d = np.linalg.inv(true) @ m
-        deg = math.degrees(math.acos(min(1.0, (np.trace(d[:3, :3]) - 1.0) / 2.0)))
-        correct += int(np.linalg.norm(d[:3, 3]) < CORRECT_LOOP_M and deg < CORRECT_LOOP_DEG)
+        d = _core.SE3.from_matrix(np.linalg.inv(true) @ m)
+        deg = math.degrees(d.angle_rad())
+        correct += int(np.linalg.norm(d.translation) < CORRECT_LOOP_M and deg < CORRECT_LOOP_DEG)
     P = np.array([p[:3, 3] for p in poses])
     path = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(P, axis=0), axis=1))]
     min_travel = MIN_LOOP_TRAVEL_FACTOR * submap_length_m
@@ -112,17 +113,6 @@ def handover(ds: GeneratedDataset, config) -> None:
             f"{k} | {j} | {kfs[k].path_m - kfs[j].path_m:.0f} | {overlap:.2f} | {ambiguity:.2f} | {error:.2f} | "
             f"{reason or 'accepted'}"
         )
-
-
-def _quat(q: list[float]) -> np.ndarray:
-    x, y, z, w = q
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-        ]
-    )
 
 
 def main() -> None:

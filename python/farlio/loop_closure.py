@@ -119,11 +119,6 @@ def _se3(m: np.ndarray) -> Any:
     return _core.SE3.from_matrix(np.asarray(m, dtype=np.float64))
 
 
-def _rotation_deg(m: np.ndarray) -> float:
-    c = (np.trace(m[:3, :3]) - 1.0) / 2.0
-    return math.degrees(math.acos(max(-1.0, min(1.0, c))))
-
-
 def _transform(points: np.ndarray, T: np.ndarray) -> np.ndarray:
     return (points @ T[:3, :3].T.astype(np.float32)) + T[:3, 3].astype(np.float32)
 
@@ -293,7 +288,7 @@ class LoopClosure:
                 distance_m,
                 overlap,
                 float(np.linalg.norm(correction[:3, 3])),
-                _rotation_deg(correction) if np.all(np.isfinite(correction)) else math.nan,
+                math.degrees(_se3(correction).angle_rad()) if np.all(np.isfinite(correction)) else math.nan,
                 ambiguity,
                 not reason,
                 reason,

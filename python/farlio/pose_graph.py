@@ -95,4 +95,12 @@ class PoseGraph:
         return self.estimate.atPose3(k).matrix()
 
     def poses(self) -> list[np.ndarray]:
-        return [self.pose(k) for k in range(len(self.odometry))]
+        """Every keyframe's global pose (4x4), in keyframe order, read from the estimate at once."""
+        rows = self.gtsam.utilities.extractPose3(self.estimate)  # (K, 12): R row by row, then t
+        out = []
+        for r in rows:
+            m = np.eye(4)
+            m[:3, :3] = r[:9].reshape(3, 3)
+            m[:3, 3] = r[9:]
+            out.append(m)
+        return out

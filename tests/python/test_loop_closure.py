@@ -71,8 +71,8 @@ def tunnel():
 
 
 def _off(T_est: np.ndarray, T_true: np.ndarray) -> tuple[float, float]:
-    d = np.linalg.inv(T_true) @ T_est
-    return float(np.linalg.norm(d[:3, 3])), math.degrees(math.acos(min(1.0, (np.trace(d[:3, :3]) - 1.0) / 2.0)))
+    d = _core.SE3.from_matrix(np.linalg.inv(T_true) @ T_est)
+    return float(np.linalg.norm(d.translation)), math.degrees(d.angle_rad())
 
 
 def test_the_second_lap_closes_and_every_accepted_loop_is_right(lap):
