@@ -2,7 +2,7 @@
 //
 // T_target_source.txt is not an independent ground truth: it is small_gicp's own GICP estimate at
 // 0.1 m downsampling (small_gicp reproduces it to 1e-4), and small_gicp's other factors and
-// resolutions land 0.06-0.66 deg away from it (scripts/compare_scan_pair.py). The scene leaves the
+// resolutions land 0.06-0.66 deg away from it (figures/odometry_scan_pair.py). The scene leaves the
 // rotation weakly constrained at the 0.1-0.3 deg level, so the bounds are: every start converges
 // to the same pose (a real property of the basin), within 2 cm / 0.2 deg of the reference with
 // 2 m voxels and the paper's sparse-point handling (point-to-point factors, line pairs kept),

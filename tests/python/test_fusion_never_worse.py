@@ -1,7 +1,7 @@
 """The fusion must never make the odometry worse: on generated sequences of every
 profile and on seeds other than the one the other tests use, the LIO's scan poses are at least as
 accurate as LiDAR-only on the same data, in APE, rotation RMSE and KITTI-style RPE (fixed 20 ms
-latency). Measured with scripts/diagnose_fusion.py; docs/fusion.md, "IMU biases, the registration's
+latency). Measured with figures/fusion_accuracy.py; docs/fusion.md, "IMU biases, the registration's
 covariance, the kernel with the fusion's guess"."""
 
 from __future__ import annotations

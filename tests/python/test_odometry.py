@@ -22,7 +22,7 @@ from farlio.simulation import generate
 # APE bound m). Measured with a fixed 20 ms latency (seed 1), bounds ~3x above:
 #   urban 10 s     LIO: APE 0.006 m, RPE 0.05 %, odometry APE 0.007 m; LiDAR-only: 0.008 m, 0.07 %
 #   handheld 25 s  LIO: APE 0.006 m, RPE 0.12 %, odometry APE 0.007 m; LiDAR-only: 0.093 m, 2.0 %
-#   (these two: scripts/measure_accuracy.py)
+#   (these two: figures/odometry_accuracy.py)
 #   racetrack 6 s  LIO: APE 0.040 m, RPE 0.23 %, odometry APE 0.049 m; LiDAR-only: 0.053 m, 0.31 %
 #                  (standing start, launch to 12 m/s: the case of docs/odometry.md "racetrack launch")
 # (LiDAR-only suffers from the 3 rad/s head turns under its constant-velocity model.)

@@ -4,7 +4,7 @@ motion within 1 s of the first scan, without a registration failure, a re-initia
 restart; over the recording its scan poses are no worse than LiDAR-only's on the same recording
 (APE and KITTI-style RPE), nor is its 100 Hz odometry; and no worse than 1.5 times the LIO started
 at rest over the same stretch of motion. Fixed 20 ms latency. The figures of docs/fusion.md
-("Starting in motion") come from scripts/start_in_motion.py, which runs the same replay."""
+("Starting in motion") come from figures/fusion_start_in_motion.py, which runs the same replay."""
 
 from __future__ import annotations
 

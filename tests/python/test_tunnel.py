@@ -1,7 +1,7 @@
 """Degeneracy: in the tunnel profile's 600 m bare section the scans do not fix the
 motion along the track. The LIO holds those directions at the IMU prediction (registration) and
 takes them from the IMU (fusion): its KITTI-style RPE stays under 1 % while LiDAR-only slides.
-docs/fusion.md "Degeneracy" has the table (`scripts/measure_tunnel.py`)."""
+docs/fusion.md "Degeneracy" has the table (`figures/fusion_tunnel.py`)."""
 
 from __future__ import annotations
 

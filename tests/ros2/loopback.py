@@ -18,7 +18,7 @@ START_TIMEOUT_S, PLAY_TIMEOUT_S, STOP_TIMEOUT_S = 30.0, 120.0, 20.0
 POLL_S = 0.02
 #: half real time: on this shared 2-core machine a frame can take longer than a scan period at
 #: times, and a scan arriving while the pipeline is busy is dropped (as in the paper); the tests
-#: want every scan (the real-time rate is measured by scripts/bench_ros2.py)
+#: want every scan (the real-time rate is measured by figures/ros2_latency.py)
 PLAY_RATE = 0.5
 OUTPUTS = ("odometry", "scan_odometry", "cloud_registered", "diagnostics")
 

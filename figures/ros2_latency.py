@@ -12,8 +12,8 @@ median and p99 of each; clouds lost (published vs received by the node); the nod
 to the CPU time of the same scans through farlio.OnlineOdometry alone (in this process, one after
 the other), as a share of one core over the run.
 
-Run with .venv-ros: .venv-ros/bin/python scripts/bench_ros2.py [--scans 100] [--input-qos best_effort]
-[--transport ros-default] [--json out.json]. Results: docs/ros2.md.
+Run with .venv-ros: .venv-ros/bin/python figures/ros2_latency.py [--scans 100] [--input-qos best_effort]
+[--transport ros-default] [--json out.json]. Results: docs/ros2.md, "Latency and CPU".
 """
 
 from __future__ import annotations

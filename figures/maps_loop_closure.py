@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
-"""Loop closure against the ground truth: `farlio run --loop-closure` (run_dataset, scans
-generated in memory, fixed 20 ms replay latency) per seed, printing
+"""Loop closure against the ground truth (docs/maps.md, "Loop closure: figures"): `farlio run
+--loop-closure` (run_dataset, scans generated in memory, fixed 20 ms replay latency) per seed,
+printing
 
   odometry / global APE   aligned translation RMSE of scans_body.tum / scans_body_global.tum (m)
   accepted / verified     loops accepted and candidates verified (loops.csv)
@@ -17,7 +18,7 @@ as if they were one place (guess: identity), and each pair's overlap, the distan
 ambiguity test's ends and the verdict are printed, with the error of the registered pose against
 the ground truth's relative pose: repeated structure must be refused or found where it truly is.
 
-Usage: python scripts/measure_loops.py [--profile racetrack] [--duration 165] [--seeds 1 2 3]
+Usage: python figures/maps_loop_closure.py [--profile racetrack] [--duration 165] [--seeds 1 2 3]
        [--lidar MODEL] [--lidar-rate HZ] [--set name=value ...] [--out DIR] [--handover]
 The racetrack's first lap takes 82.7 s: 165 s is two laps (8.3 km).
 """
@@ -32,16 +33,27 @@ from pathlib import Path
 
 import numpy as np
 from farlio import _core
-from farlio.config import load_config
 from farlio.loop_closure import LOOPS_CSV, MIN_LOOP_TRAVEL_FACTOR, LoopClosure
 from farlio.mapping import MapOptions
-from farlio.runner import replay_options, run_dataset
-from measure_maps import FIXED_LATENCY_S, GeneratedDataset
+from harness import GeneratedDataset, ape_m, config, fixed_latency, run, table_row
 from scipy.spatial.transform import Rotation  # xyzw quaternions, as loops.csv
 
 CORRECT_LOOP_M, CORRECT_LOOP_DEG = 0.5, 1.0
 REVISIT_M = 5.0
 HANDOVER_SEPARATION_M, HANDOVER_STRIDE = (60.0, 200.0), 10
+#: the columns of a handed-over pair
+HANDOVER_COLUMNS = ("query", "match", "separation m", "overlap", "ambiguity m", "error vs truth m", "verdict")
+#: the columns of a run's row
+COLUMNS = (
+    "seed",
+    "odometry APE m",
+    "global APE m",
+    "accepted / verified",
+    "precision",
+    "recall",
+    "verify s",
+    "graph s",
+)
 
 
 def gt_lidar(gen) -> tuple[np.ndarray, list[np.ndarray]]:
@@ -81,12 +93,10 @@ def precision_recall(gen, loops_csv: Path, submap_length_m: float) -> tuple[floa
     return precision, recall
 
 
-def handover(ds: GeneratedDataset, config) -> None:
+def handover(ds: GeneratedDataset, cfg) -> None:
     """Different places handed over as one (see the module doc)."""
-    odo = _core.Odometry(
-        config, ds.T_imu_lidar(), ds.gravity_m_s2(), ds.imu(), replay_options("fixed", FIXED_LATENCY_S)
-    )
-    loops = LoopClosure(config, ds.T_imu_lidar())
+    odo = _core.Odometry(cfg, ds.T_imu_lidar(), ds.gravity_m_s2(), ds.imu(), fixed_latency())
+    loops = LoopClosure(cfg, ds.T_imu_lidar())
     for i in range(len(ds)):
         scan = ds.scan(i)
         fr = odo.process(scan)
@@ -100,7 +110,7 @@ def handover(ds: GeneratedDataset, config) -> None:
 
     kfs = loops.keyframes
     print(f"{len(kfs)} keyframes, {sum(r.accepted for r in loops.records)} loops accepted in the run")
-    print("query | match | separation m | overlap | ambiguity m | error vs truth m | verdict")
+    print(table_row(*HANDOVER_COLUMNS))
     for k in range(0, len(kfs), HANDOVER_STRIDE):
         far = [j for j in range(k) if HANDOVER_SEPARATION_M[0] <= kfs[k].path_m - kfs[j].path_m]
         far = [j for j in far if kfs[k].path_m - kfs[j].path_m <= HANDOVER_SEPARATION_M[1]]
@@ -109,9 +119,11 @@ def handover(ds: GeneratedDataset, config) -> None:
         j = far[-1]
         T, overlap, ambiguity, reason = loops.check(k, j, np.eye(4))
         error = np.linalg.norm((np.linalg.inv(np.linalg.inv(at(kfs[j].stamp_ns)) @ at(kfs[k].stamp_ns)) @ T)[:3, 3])
+        separation = kfs[k].path_m - kfs[j].path_m
         print(
-            f"{k} | {j} | {kfs[k].path_m - kfs[j].path_m:.0f} | {overlap:.2f} | {ambiguity:.2f} | {error:.2f} | "
-            f"{reason or 'accepted'}"
+            table_row(
+                k, j, f"{separation:.0f}", f"{overlap:.2f}", f"{ambiguity:.2f}", f"{error:.2f}", reason or "accepted"
+            )
         )
 
 
@@ -127,38 +139,25 @@ def main() -> None:
     ap.add_argument("--handover", action="store_true", help="different places handed over as one (module doc)")
     args = ap.parse_args()
     out = args.out or Path(tempfile.mkdtemp(prefix="measure_loops_"))
-    config = load_config(None, args.set)
+    cfg = config(args.set)
     if args.handover:
         for seed in args.seeds:
             handover(
                 GeneratedDataset(
                     args.profile, seed, args.duration, out, lidar=args.lidar, lidar_rate_hz=args.lidar_rate
                 ),
-                config,
+                cfg,
             )
         return
-    print("seed | odometry APE m | global APE m | accepted / verified | precision | recall | verify s | graph s")
+    print(table_row(*COLUMNS))
     for seed in args.seeds:
         ds = GeneratedDataset(args.profile, seed, args.duration, out, lidar=args.lidar, lidar_rate_hz=args.lidar_rate)
-        s = run_dataset(
-            ds,
-            out / f"run-{seed}",
-            config,
-            maps=MapOptions(loop_closure=True),
-            progress=False,
-            plot=False,
-            options=replay_options("fixed", FIXED_LATENCY_S),
-        )
+        s = run(ds, out / f"run-{seed}", cfg, MapOptions(loop_closure=True))
         lc = s["loop_closure"]
-        precision, recall = precision_recall(
-            ds.gen, out / f"run-{seed}" / LOOPS_CSV, config.get("loop.submap_length_m")
-        )
-        print(
-            f"{seed} | {s['accuracy']['ape']['translation_m']['rmse']:.3f} | "
-            f"{s['accuracy_global']['ape']['translation_m']['rmse']:.3f} | {lc['accepted']} / {lc['candidates']} | "
-            f"{precision:.2f} | {recall:.2f} | {lc['verify_s']:.1f} | {lc['graph_s']:.2f}",
-            flush=True,
-        )
+        precision, recall = precision_recall(ds.gen, out / f"run-{seed}" / LOOPS_CSV, cfg.get("loop.submap_length_m"))
+        cells = [f"{ape_m(s['accuracy']):.3f}", f"{ape_m(s['accuracy_global']):.3f}"]
+        cells += [f"{lc['accepted']} / {lc['candidates']}", f"{precision:.2f}", f"{recall:.2f}"]
+        print(table_row(seed, *cells, f"{lc['verify_s']:.1f}", f"{lc['graph_s']:.2f}"), flush=True)
     print(f"outputs in {out}")
 
 

@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """Where does the fusion lose accuracy? Runs the deterministic replay on generated sequences with one
 fusion part changed at a time and prints, per variant, the accuracy of the registered scan poses
-against the exact ground truth, next to LiDAR-only on the same data (CHANGELOG.md, "Diagnosis").
+against the exact ground truth, next to LiDAR-only on the same data: docs/fusion.md, "IMU biases, the
+registration's covariance, the kernel with the fusion's guess" (its Figures table's racetrack row,
+the covariance scale, rot|line), and CHANGELOG.md, "Diagnosis".
 
 Each variant isolates one part of the fusion:
   lidar_only      no fusion (the reference the LIO must not be worse than)
@@ -27,9 +29,9 @@ residual over the lateral spread; docs/fusion.md); "align", the angle of the eva
 with the first pose aligned (m), the median rotation error of the initial guess the fusion gave the
 registration (deg; "-" without fusion) and the rotation RMSE of the 100 Hz fused odometry (deg).
 
-  python scripts/diagnose_fusion.py --profile racetrack --duration 30 --seeds 1 2 \
+  python figures/fusion_accuracy.py --profile racetrack --duration 30 --seeds 1 2 \
       [--variants lio lidar_only ...] [--set name=value ...]
-  python scripts/diagnose_fusion.py --profile urban --duration 10 --seeds 1 --covariance-scale
+  python figures/fusion_accuracy.py --profile urban --duration 10 --seeds 1 --covariance-scale
 """
 
 from __future__ import annotations
@@ -45,13 +47,11 @@ import farlio  # noqa: F401  (loads the extension)
 import numpy as np
 from farlio import _core
 from farlio.evaluation import make_options
-from farlio.runner import replay_options
-from farlio.simulation import generate
+from harness import fixed_latency, generated_sequence
 
 #: rot|line: positions must spread this many RMS residuals across an axis to fix the rotation about
 #: it (eval's min_spread_to_residual, default 3); only the principal axis of a drive passes
 LINE_MIN_SPREAD_TO_RESIDUAL = 1000.0
-FIXED_LATENCY_S = 0.02  # the accuracy tables' latency model (scripts/measure_accuracy.py)
 
 # the paper's filter: no bias states, the fixed LiDAR noise
 PAPER_FILTER = {"fusion.estimate_imu_bias": "false", "fusion.lidar_information_from_registration": "false"}
@@ -103,9 +103,7 @@ class Sequence:
     the ideal IMU, ground truth."""
 
     def __init__(self, profile: str, seed: int, duration_s: float, cache: Path):
-        folder = cache / f"{profile}_seed{seed}_{duration_s:g}s"
-        if not (folder / "meta.yaml").exists():
-            generate(profile, folder, seed=seed, duration_s=duration_s)
+        folder = generated_sequence(cache, profile, seed, duration_s)
         cfg = _core.sim.default_config(profile)
         cfg.seed, cfg.duration_s, cfg.noise_free = seed, duration_s, True
         self.ideal_imu = _core.sim.SequenceGenerator(cfg).imu()
@@ -124,7 +122,7 @@ def run_variant(seq: Sequence, overrides: dict[str, str], imu_source: str) -> di
     for name, value in overrides.items():
         config.set(name, value)
     imu = mixed_imu(seq.imu, seq.ideal_imu, imu_source) if config.get("fusion.enabled") else []
-    odo = _core.Odometry(config, seq.T_imu_lidar, seq.gravity_m_s2, imu, replay_options("fixed", FIXED_LATENCY_S))
+    odo = _core.Odometry(config, seq.T_imu_lidar, seq.gravity_m_s2, imu, fixed_latency())
     T_lidar_imu = seq.T_imu_lidar.inverse()
     scans, odometry = _core.Trajectory(), _core.Trajectory()
     guess_errors = []
@@ -179,7 +177,7 @@ def covariance_scale(seq: Sequence) -> tuple[float, float]:
     pose against the truth (sensor frame, [t; r])."""
     config = _core.Config()
     config.set("fusion.enabled", "false")
-    odo = _core.Odometry(config, seq.T_imu_lidar, seq.gravity_m_s2, [], replay_options("fixed", FIXED_LATENCY_S))
+    odo = _core.Odometry(config, seq.T_imu_lidar, seq.gravity_m_s2, [], fixed_latency())
     truth = [p * seq.T_imu_lidar for p in poses(seq.gt_scans)]
     previous, nees = None, []
     for scan, true_pose in zip(seq.scans, truth, strict=True):

@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""What parts of a frame cost, by switching them off or on in turns (docs/performance.md, items 8-9):
+"""What parts of a frame cost, by switching them off or on in turns (docs/performance.md, "What makes each stage
+fast", items 8-9):
 the LiDAR-only scan pipeline runs over the same scans once per variant and round, the variants
 alternating so that all see the same machine load. Per data set and variant it prints the median
 and p99 of the whole frame, the stage medians, and the registration time of the second frame
@@ -11,7 +12,7 @@ Variants (config fields changed against the defaults):
   no_undistortion   preprocess.undistort=false
   no_shape_test     map.line_eigenvalue_ratio=1 (no eigenvalues: every covariance a surface)
 
-    python scripts/measure_frame_parts.py --data ../shared/data/real/kitti_16_scans --profile urban \\
+    python figures/performance_frame_parts.py --data ../shared/data/real/kitti_16_scans --profile urban \\
         --threads 1 2 --rounds 3
 """
 
@@ -23,7 +24,7 @@ import sys
 import numpy as np
 from farlio import _core
 from farlio.benchmark import STAGES, generated_scans
-from farlio.datasets import open_dataset
+from harness import pipeline_config, recording_scans
 
 MS_PER_S = 1e3
 P99 = 99
@@ -39,12 +40,7 @@ VARIANTS = {
 
 def run(scans: list, threads: int, overrides: dict[str, str]) -> dict[str, list[float]]:
     """Per frame: the whole frame and each stage (ms), one pipeline over the scans."""
-    config = _core.Config()
-    config.set("num_threads", str(threads))
-    config.set("device", "cpu")
-    for name, value in overrides.items():
-        config.set(name, value)
-    pipe = _core.ScanPipeline(config)
+    pipe = _core.ScanPipeline(pipeline_config(threads, overrides))
     out: dict[str, list[float]] = {"total": [], **{s: [] for s in STAGES}}
     for scan in scans:
         t = pipe.process(scan).timings
@@ -64,9 +60,7 @@ def main() -> int:
     p.add_argument("--variants", nargs="+", default=list(VARIANTS), choices=list(VARIANTS))
     args = p.parse_args()
     sets = [(f"profile:{name}", generated_scans(name, args.scans)[0]) for name in args.profile]
-    for path in args.data:
-        ds = open_dataset(path)
-        sets.append((path, [ds.scan(i) for i in range(len(ds))]))
+    sets += [(path, recording_scans(path)) for path in args.data]
     for name, scans in sets:
         for threads in args.threads:
             runs: dict[str, list[dict[str, list[float]]]] = {v: [] for v in args.variants}

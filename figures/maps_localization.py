@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Maps: map a generated sequence once, then run a second pass over the same scene (other
+"""Odometry against localization in a saved map (docs/maps.md, "Figures"): map a generated sequence
+once, then run a second pass over the same scene (other
 noise seeds) twice, as odometry and localized in the saved map (`--prior-map`), with the same code
 path as `farlio run` (run_dataset) on scans generated in memory (no sequence on disk: a racetrack
 lap is ~7 GB of PCD). Prints per profile and pass seed:
@@ -16,7 +17,7 @@ lap is ~7 GB of PCD). Prints per profile and pass seed:
 and the map's size, memory and export time per scan; writes error_over_time_<profile>.png (the
 error in the ground truth's frame over time, odometry vs localization) and maps.json into --out.
 
-Usage: python scripts/measure_maps.py [--profiles urban handheld racetrack] [--pass-seeds 2 3]
+Usage: python figures/maps_localization.py [--profiles urban handheld racetrack] [--pass-seeds 2 3]
        [--out DIR]
 Racetrack: the map is the first lap (85 s), each pass two laps (165 s).
 """
@@ -24,55 +25,18 @@ Racetrack: the map is the first lap (85 s), each pass two laps (165 s).
 from __future__ import annotations
 
 import argparse
-import csv
 import json
-import tempfile
 from pathlib import Path
-from typing import Any
 
-import farlio
 import numpy as np
 from farlio import _core
-from farlio.config import load_config
-from farlio.datasets.base import Dataset
 from farlio.mapping import MAP_PCD, MapOptions
-from farlio.runner import SCANS_BODY_TUM, replay_options, run_dataset
-from farlio.simulation import make_config
+from farlio.runner import SCANS_BODY_TUM
+from harness import GeneratedDataset, ape_m, config, floats, run, timing_rows, work_folder
 
 #: (map duration, pass duration) in seconds
 DURATIONS_S = {"urban": (60.0, 60.0), "handheld": (60.0, 60.0), "racetrack": (85.0, 165.0), "tunnel": (45.0, 45.0)}
 MAP_SEED = 1
-FIXED_LATENCY_S = 0.02
-
-
-class GeneratedDataset(Dataset):
-    """A generated sequence served from memory, scan by scan, with its ground truth as TUM files."""
-
-    def __init__(self, profile: str, seed: int, duration_s: float, work: Path, **sim: Any):
-        """sim: further make_config arguments (lidar, lidar_rate_hz, ...)."""
-        self.gen = _core.sim.SequenceGenerator(make_config(profile, seed=seed, duration_s=duration_s, **sim))
-        self.path = work / f"{profile}-{seed}"
-        self.path.mkdir(parents=True, exist_ok=True)
-        self.gt_scans = self.path / "groundtruth_scans.tum"
-        _core.io.write_tum(self.gt_scans, self.gen.groundtruth_scans())
-
-    def __len__(self) -> int:
-        return self.gen.num_scans()
-
-    def scan(self, i: int) -> farlio.Scan:
-        return self.gen.scan(i)
-
-    def imu(self) -> list:
-        return self.gen.imu()
-
-    def T_imu_lidar(self) -> farlio.SE3:
-        return self.gen.T_imu_lidar()
-
-    def gravity_m_s2(self) -> float:
-        return self.gen.gravity_m_s2()
-
-    def groundtruth_scans_file(self) -> Path:
-        return self.gt_scans
 
 
 def poses(path: Path) -> dict[int, np.ndarray]:
@@ -90,27 +54,20 @@ def error_in_gt_frame(est: dict, gt: dict, frame_est: dict) -> tuple[np.ndarray,
     return (np.array(stamps) - stamps[0]) / 1e9, err
 
 
-def run(dataset: Dataset, out: Path, maps: MapOptions) -> dict:
-    return run_dataset(
-        dataset, out, load_config(None, []), progress=False, plot=False, maps=maps,
-        options=replay_options("fixed", FIXED_LATENCY_S),
-    )  # fmt: skip
-
-
 def frame_stats(out: Path) -> tuple[float, float, float]:
     """(median, p99 frame time in ms, smallest inlier fraction) of a run's timing.csv."""
-    with open(out / "timing.csv") as f:
-        rows = [r for r in csv.DictReader(f) if r["total_ms"]]
-    ms = [float(r["total_ms"]) for r in rows]
-    inliers = [float(r["inlier_fraction"]) for r in rows if r["inlier_fraction"]]
+    rows = timing_rows(out, "total_ms")
+    ms, inliers = floats(rows, "total_ms"), floats(rows, "inlier_fraction")
     return float(np.median(ms)), float(np.percentile(ms, 99)), min(inliers, default=float("nan"))
 
 
 def measure(profile: str, pass_seeds: list[int], out: Path, work: Path) -> dict:
     map_s, pass_s = DURATIONS_S[profile]
-    mapping = run(GeneratedDataset(profile, MAP_SEED, map_s, work), work / f"{profile}-map", MapOptions(save=True))
+    mapping = run(
+        GeneratedDataset(profile, MAP_SEED, map_s, work), work / f"{profile}-map", config(), MapOptions(save=True)
+    )
     mapping_poses = poses(work / f"{profile}-map" / SCANS_BODY_TUM)
-    result = {"map": mapping["map"], "mapping_ape_m": mapping["accuracy"]["ape"]["translation_m"]["rmse"], "passes": {}}
+    result = {"map": mapping["map"], "mapping_ape_m": ape_m(mapping["accuracy"]), "passes": {}}
     curves = {}
     for seed in pass_seeds:
         row = {}
@@ -120,7 +77,7 @@ def measure(profile: str, pass_seeds: list[int], out: Path, work: Path) -> dict:
         ):
             data = GeneratedDataset(profile, seed, pass_s, work)
             o = work / f"{profile}-{seed}-{mode}"
-            s = run(data, o, maps)
+            s = run(data, o, config(), maps)
             est, gt = poses(o / SCANS_BODY_TUM), poses(data.gt_scans)
             t, err = error_in_gt_frame(est, gt, mapping_poses if mode == "localization" else est)
             common = [k for k in sorted(est) if k in mapping_poses]
@@ -128,7 +85,7 @@ def measure(profile: str, pass_seeds: list[int], out: Path, work: Path) -> dict:
             t_map = (np.array(common) - common[0]) / 1e9
             med, p99, min_inliers = frame_stats(o)
             row[mode] = {
-                "ape_m": s["accuracy"]["ape"]["translation_m"]["rmse"],
+                "ape_m": ape_m(s["accuracy"]),
                 "err_end_m": float(err[-1]),
                 "vs_map_end_m": float(vs_map[-1]),
                 "vs_map_max_m": float(vs_map.max()),
@@ -182,9 +139,9 @@ def main() -> None:
     args = ap.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     results = {}
-    with tempfile.TemporaryDirectory(prefix="farlio-maps-") as tmp:
+    with work_folder(prefix="farlio-maps-") as tmp:
         for profile in args.profiles:
-            r = measure(profile, args.pass_seeds, args.out, Path(tmp))
+            r = measure(profile, args.pass_seeds, args.out, tmp)
             results[profile] = r
             m = r["map"]
             print(

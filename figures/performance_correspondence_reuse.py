@@ -1,10 +1,11 @@
-"""Accuracy and registration time against registration.correspondence_reuse_m (docs/performance.md).
+"""Accuracy and registration time against registration.correspondence_reuse_m (docs/performance.md,
+"What makes each stage fast", item 6).
 
 LiDAR-only scan pipeline (ScanPipeline) over the same scans for each reuse distance: generated
 profiles (80 scans, with ground truth: APE and KITTI-style RPE) and recordings (no ground truth:
 the largest position difference from the run without reuse). Medians over --rounds runs.
 
-    python scripts/measure_correspondence_reuse.py --profile urban --profile handheld --profile racetrack \
+    python figures/performance_correspondence_reuse.py --profile urban --profile handheld --profile racetrack \
         --data ../shared/data/real/kitti_16_scans
 """
 
@@ -18,7 +19,7 @@ import farlio
 import numpy as np
 from farlio import _core
 from farlio.benchmark import generated_scans
-from farlio.datasets import open_dataset
+from harness import pipeline_config, recording_scans
 
 REUSE_M = (0.0, 0.005, 0.01, 0.02, 0.05)
 GENERATED_SCANS = 80
@@ -31,11 +32,7 @@ def run(scans: list, reuse_m: float, threads: int, rounds: int) -> tuple[float, 
     """(median frame ms, median registration ms, trajectory of the last round)."""
     frame, registration = [], []
     for _ in range(rounds):
-        cfg = _core.Config()
-        cfg.set("num_threads", str(threads))
-        cfg.set("device", "cpu")
-        cfg.set("registration.correspondence_reuse_m", str(reuse_m))
-        pipe = _core.ScanPipeline(cfg)
+        pipe = _core.ScanPipeline(pipeline_config(threads, {"registration.correspondence_reuse_m": str(reuse_m)}))
         traj = farlio.Trajectory()
         for k, s in enumerate(scans):
             t0 = time.perf_counter()
@@ -62,9 +59,7 @@ def main() -> int:
     ap.add_argument("--rounds", type=int, default=3, help="runs per reuse distance")
     args = ap.parse_args()
     sets = [(p, *generated_scans(p, GENERATED_SCANS)[:2]) for p in args.profile]
-    for path in args.data:
-        ds = open_dataset(path)
-        sets.append((path, [ds.scan(i) for i in range(len(ds))], None))
+    sets += [(path, recording_scans(path), None) for path in args.data]
     columns = f"{'reuse m':>7s} {'frame ms':>9s} {'reg ms':>7s} {'APE m':>8s} {'RPE %':>7s} {'max |dpos| mm':>14s}"
     print(f"{'data':28s} {columns}")
     for name, scans, gt in sets:

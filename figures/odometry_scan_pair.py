@@ -1,19 +1,24 @@
 #!/usr/bin/env python3
-"""How well-determined is ../shared/data/real/scan_pair? Registers it with farlio (default and
-2 m voxels) and, if the `small_gicp` package is installed (pip install small_gicp), with
-small_gicp's factors at several downsampling resolutions, printing each result's distance to
-T_target_source.txt. Used to set the bounds of tests/cpp/test_scan_pair.cpp."""
+"""How well-determined is ../shared/data/real/scan_pair? (docs/odometry.md, "Measured figures": the
+real scan pair.) Registers it with farlio (4, 2 and 1 m voxels) and, if the `small_gicp` package is
+installed (pip install small_gicp), with small_gicp's factors at several downsampling resolutions,
+printing each result's distance to T_target_source.txt. Used to set the bounds of
+tests/cpp/test_scan_pair.cpp.
+
+    python figures/odometry_scan_pair.py [DIR]   (DIR: the pair's folder, default ../shared/data/real/scan_pair)
+"""
 
 from __future__ import annotations
 
-import sys
+import argparse
 from pathlib import Path
 
 import farlio
 import numpy as np
 from farlio import _core
 
-DATA = Path(sys.argv[1]) if len(sys.argv) > 1 else Path(__file__).resolve().parents[2] / "shared/data/real/scan_pair"
+#: ../shared/data/real/scan_pair next to the repository
+DEFAULT_DATA = Path(__file__).resolve().parents[2] / "shared/data/real/scan_pair"
 
 
 def error(gt: np.ndarray, T: np.ndarray) -> tuple[float, float]:
@@ -22,9 +27,12 @@ def error(gt: np.ndarray, T: np.ndarray) -> tuple[float, float]:
 
 
 def main() -> None:
-    gt = np.loadtxt(DATA / "T_target_source.txt")
-    src = _core.io.read_point_cloud(DATA / "source.ply")
-    tgt = _core.io.read_point_cloud(DATA / "target.ply")
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("data", nargs="?", type=Path, default=DEFAULT_DATA, help="the scan pair's folder")
+    data = p.parse_args().data
+    gt = np.loadtxt(data / "T_target_source.txt")
+    src = _core.io.read_point_cloud(data / "source.ply")
+    tgt = _core.io.read_point_cloud(data / "target.ply")
     for voxel in (4.0, 2.0, 1.0):
         cfg = _core.Config()
         cfg.set("map.voxel_size_m", str(voxel))
@@ -38,8 +46,8 @@ def main() -> None:
     except ImportError:
         print("small_gicp not installed: skipping its rows")
         return
-    T = small_gicp.read_ply(str(DATA / "target.ply"))
-    S = small_gicp.read_ply(str(DATA / "source.ply"))
+    T = small_gicp.read_ply(str(data / "target.ply"))
+    S = small_gicp.read_ply(str(data / "source.ply"))
     for res in (0.1, 0.25, 0.5, 1.0):
         for reg in ("GICP", "VGICP", "PLANE_ICP", "ICP"):
             r = small_gicp.align(

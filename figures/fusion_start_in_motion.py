@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
-"""Starting in motion: the LIO on a recording that begins while the body moves, against LiDAR-only on
-the same recording and against the LIO started at rest over the same stretch of motion.
+"""Starting in motion (docs/fusion.md, "Starting in motion: figures"): the LIO on a recording that
+begins while the body moves, against LiDAR-only on the same recording and against the LIO started
+at rest over the same stretch of motion.
 
 For each profile, start and seed, the generator records `--duration` seconds from `--start` seconds
 into the profile's motion (SimConfig.motion_start_s: a cut recording, a node restarted at speed),
@@ -13,8 +14,8 @@ its estimate of up was from the truth then and at the end; then the ratios the g
 LiDAR-only, LIO / standstill start), of the scan poses and of the 100 Hz odometry (against
 LiDAR-only's scan poses, its only output).
 
-  python scripts/start_in_motion.py --profile racetrack --start 12 --duration 10 --seeds 1 2 3
-  python scripts/start_in_motion.py --profile urban --start 10 --duration 10 --seeds 1 2 3 --no-reference
+  python figures/fusion_start_in_motion.py --profile racetrack --start 12 --duration 10 --seeds 1 2 3
+  python figures/fusion_start_in_motion.py --profile urban --start 10 --duration 10 --seeds 1 2 3 --no-reference
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ import math
 import sys
 
 from farlio.simulation import LIDAR_MODELS, PROFILES, Recording, make_config, replay, stretch_accuracy
+from harness import FIXED_LATENCY_S, mode_overrides
 
 COLUMNS = ["ape_m", "rpe_pct", "rot_deg", "odom_ape_m", "odom_rpe_pct", "failed", "map_restarts", "reinit"]
 COLUMNS += ["rejected", "first_output_s"]
@@ -73,8 +75,10 @@ def main() -> int:
             )
         )
         runs = {
-            "LIO": stretch_accuracy(replay(cut, args.overrides)),
-            "LiDAR-only": stretch_accuracy(replay(cut, [*args.overrides, "fusion.enabled=false"])),
+            "LIO": stretch_accuracy(replay(cut, mode_overrides(args.overrides), fixed_latency_s=FIXED_LATENCY_S)),
+            "LiDAR-only": stretch_accuracy(
+                replay(cut, mode_overrides(args.overrides, "lidar-only"), fixed_latency_s=FIXED_LATENCY_S)
+            ),
         }
         if not args.no_reference:
             whole = Recording(
@@ -86,7 +90,8 @@ def main() -> int:
                     lidar=args.lidar,
                 )
             )
-            runs["standstill start"] = stretch_accuracy(replay(whole, args.overrides), from_s=args.start)
+            ref_run = replay(whole, mode_overrides(args.overrides), fixed_latency_s=FIXED_LATENCY_S)
+            runs["standstill start"] = stretch_accuracy(ref_run, from_s=args.start)
         print(f"seed {seed} (speed at the cut {cut.speed_at_start_m_s:.1f} m/s)")
         for name, row in runs.items():
             print(f"  {name:17s} " + " ".join(fmt(row.get(c, math.nan)) for c in COLUMNS))

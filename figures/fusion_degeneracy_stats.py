@@ -1,20 +1,23 @@
 #!/usr/bin/env python3
-"""Per run, what the registration's thresholds saw, from the timing.csv of `farlio run`: the
+"""The figures behind the degeneracy threshold (docs/fusion.md, "Degeneracy": why 0.05 m) and the
+kernel with the fusion's guess. Per run, what the registration's thresholds saw, from the timing.csv
+of `farlio run`: the
 adaptive sigma and the Cauchy kernel scale used (docs/fusion.md: the kernel with the
 fusion's guess), and the degeneracy statistics (the largest translation std, the largest std per
 matched point = translation_std_max_m * sqrt(inliers), the largest rotation std, the flagged scans,
 and the per-point std of the scans whose std exceeds --bare-std-m: the tunnel's bare section).
 
-Usage: python scripts/degeneracy_stats.py RUN_DIR [RUN_DIR ...] [--bare-std-m 0.06]
+Usage: python figures/fusion_degeneracy_stats.py RUN_DIR [RUN_DIR ...] [--bare-std-m 0.06]
 (RUN_DIR: the --out of `farlio run SEQ --out RUN_DIR --latency fixed --fixed-latency 0.02`)."""
 
 from __future__ import annotations
 
 import argparse
-import csv
 import math
 import statistics
 from pathlib import Path
+
+from harness import timing_rows
 
 
 def _floats(rows: list[dict[str, str]], column: str) -> list[float]:
@@ -22,8 +25,7 @@ def _floats(rows: list[dict[str, str]], column: str) -> list[float]:
 
 
 def stats(run: Path, bare_std_m: float) -> str:
-    with open(run / "timing.csv", newline="") as f:
-        rows = [r for r in csv.DictReader(f) if r.get("translation_std_max_m")]
+    rows = timing_rows(run, "translation_std_max_m")
     if not rows:
         return f"{run.name}: no registered scan with degeneracy columns"
     sigma, kernel = _floats(rows, "sigma_m"), _floats(rows, "kernel_scale_m")

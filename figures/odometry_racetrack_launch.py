@@ -1,15 +1,15 @@
 #!/usr/bin/env python3
-"""The racetrack launch (docs/odometry.md): every 5th scan of a generated racetrack sequence,
-undistorted with the TRUE motion, is registered against the first (standstill) scan starting from
+"""The racetrack launch (docs/odometry.md, "Measured figures"): every 5th scan of a generated
+racetrack sequence, undistorted with the TRUE motion, is registered against the first (standstill) scan starting from
 its TRUE pose; prints how far the registration moves it. A false minimum at "no motion" shows as
 a move of minus the distance travelled. Usage:
-  farlio simulate racetrack --duration 6 --out rt && python scripts/diagnose_racetrack.py rt [name=value ...]
+  farlio simulate racetrack --duration 6 --out rt && python figures/odometry_racetrack_launch.py rt [name=value ...]
 e.g. registration.point_to_point_sigma_m=0.0316 registration.skip_line_pairs=false (the paper's weighting).
 """
 
 from __future__ import annotations
 
-import sys
+import argparse
 
 import farlio
 import numpy as np
@@ -21,13 +21,17 @@ EVERY = 5
 
 
 def main() -> None:
-    seq = sys.argv[1]
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("sequence", help="a generated racetrack sequence folder (farlio simulate racetrack)")
+    p.add_argument("overrides", nargs="*", metavar="NAME=VALUE", help="config fields of the registration")
+    args = p.parse_args()
+    seq = args.sequence
     reader = _core.io.SequenceReader(seq)
     T = reader.calibration().T_imu_lidar.matrix()
     G = reader.groundtruth_scans().matrices()
     gt = np.loadtxt(f"{seq}/groundtruth.tum")  # dense body poses; the launch is straight: no rotation
     cfg = _core.Config()
-    for item in sys.argv[2:]:
+    for item in args.overrides:
         cfg.set(*item.split("=", 1))
 
     def position_at(t: np.ndarray) -> np.ndarray:

@@ -1,10 +1,12 @@
 #!/usr/bin/env python3
-"""The largest frames of one LiDAR-only run, from the stage times the pipeline measures itself
-(`FrameResult.timings`), without the rest of `farlio bench` in the process (no KISS-ICP, no
-yardsticks): the median and p99 of the whole frame and, per largest frame, its stages
-(docs/performance.md: the first frame builds the submap and is the largest).
+"""The largest frames of one LiDAR-only run (docs/performance.md, "Whole frame next to KISS-ICP"),
+from the stage times the pipeline measures itself (`FrameResult.timings`), without the rest of
+`farlio bench` in the process (no KISS-ICP, no yardsticks): the median and p99 of the whole frame
+and, per largest frame, its stages (docs/performance.md: the first frame builds the submap and is
+the largest).
 
-    python scripts/frame_times.py --profile urban --scans 100 --threads 2 [--data DIR] [--top 8] [--repeat N]
+    python figures/performance_frame_times.py --profile urban --scans 100 --threads 2 [--data DIR] [--top 8] \
+        [--repeat N]
 
 With --repeat N the scans run N times, each time through a new pipeline (the frames of all runs
 counted): enough frames of a short recording for `perf record` to sample (docs/performance.md).
@@ -17,7 +19,7 @@ import argparse
 import numpy as np
 from farlio import _core
 from farlio.benchmark import STAGES, generated_scans
-from farlio.datasets import open_dataset
+from harness import pipeline_config, recording_scans
 
 MS_PER_S = 1e3
 P99 = 99
@@ -32,14 +34,8 @@ def main() -> None:
     p.add_argument("--top", type=int, default=8, help="largest frames listed")
     p.add_argument("--repeat", type=int, default=1, help="runs over the scans, each with a new pipeline")
     args = p.parse_args()
-    if args.data:
-        ds = open_dataset(args.data)
-        scans = [ds.scan(i) for i in range(len(ds))]
-    else:
-        scans = generated_scans(args.profile, args.scans)[0]
-    config = _core.Config()
-    config.set("num_threads", str(args.threads))
-    config.set("device", "cpu")
+    scans = recording_scans(args.data) if args.data else generated_scans(args.profile, args.scans)[0]
+    config = pipeline_config(args.threads)
     rows = []
     for _ in range(max(1, args.repeat)):
         pipe = _core.ScanPipeline(config)

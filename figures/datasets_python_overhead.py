@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Per-frame cost of the Python path (dataloader + bindings) next to the C++ pipeline alone.
+"""Per-frame cost of the Python path (dataloader + bindings) next to the C++ pipeline alone
+(docs/datasets.md, "Cost of the Python path").
 
 Generates a short urban sequence, writes it as a sequence folder and as a ROS 2 MCAP bag, then
 for every scan measures separately:
@@ -9,22 +10,20 @@ for every scan measures separately:
   * the pipeline: the C++ pipeline's own total time for that frame (timings.total_s).
 The binding overhead is the call minus the pipeline. Prints medians in ms.
 
-    .venv/bin/python scripts/measure_python_overhead.py [--seconds 5] [--threads 2]
+    .venv/bin/python figures/datasets_python_overhead.py [--seconds 5] [--threads 2]
 """
 
 from __future__ import annotations
 
 import argparse
 import statistics
-import tempfile
 import time
-from pathlib import Path
 
 from farlio import _core
 from farlio.datasets import open_dataset
 from farlio.datasets.rosbag_write import write_dataset
 from farlio.runner import replay_options
-from farlio.simulation import make_config, write_sequence
+from harness import generated_sequence, work_folder
 
 MS_PER_S = 1e3
 DEFAULT_SECONDS = 5.0
@@ -62,11 +61,9 @@ def main() -> int:
     parser.add_argument("--seconds", type=float, default=DEFAULT_SECONDS, help="length of the generated sequence")
     parser.add_argument("--threads", type=int, default=0, help="pipeline threads (0: all)")
     args = parser.parse_args()
-    with tempfile.TemporaryDirectory(prefix="farlio-overhead-") as tmp:
-        folder = Path(tmp) / "seq"
-        write_sequence(make_config("urban", duration_s=args.seconds), folder)
-        seq = open_dataset(folder)
-        bag = write_dataset(seq, Path(tmp) / "bag", "mcap", "ouster")
+    with work_folder(prefix="farlio-overhead-") as tmp:
+        seq = open_dataset(generated_sequence(tmp, "urban", duration_s=args.seconds))
+        bag = write_dataset(seq, tmp / "bag", "mcap", "ouster")
         rows = {
             "sequence folder": measure(seq, args.threads),
             "ROS 2 MCAP bag": measure(open_dataset(bag), args.threads),
