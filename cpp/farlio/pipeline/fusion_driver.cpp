@@ -330,6 +330,14 @@ void FusionDriver::link(const Scan& scan, OdometryFrame& frame) {
         "not fused: the scan ends " + seconds_text(ns_to_seconds(clock_ns_) - ns_to_seconds(stamp_ns)) +
         " s before the IMU clock, beyond fusion.max_bridged_gap_s (do the IMU and LiDAR clocks differ?)";
   }
+  if (frame.drop_reason.empty() && fusion_ && has_imu() && !fusion_->initialized() && frame.degeneracy &&
+      frame.degeneracy->degenerate_translations > 0) {
+    // a pose that stands still along a direction the scan does not constrain says nothing of the
+    // velocity there (a sparse LiDAR at speed between parallel walls registers as standing): the
+    // filter starts from a run of scans that constrain every direction
+    fusion_->restart_window();
+    frame.drop_reason = "not fused: the filter is not initialised from a scan with a degenerate direction";
+  }
   if (frame.drop_reason.empty() && fusion_ && has_imu()) {
     Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
     std::optional<Eigen::Matrix3d> velocity_covariance;
