@@ -471,7 +471,14 @@ def format_summary(s: dict[str, Any]) -> str:
     init = s.get("fusion", {}).get("initialization")
     if init is not None:
         if init["mode"] is None:
-            lines.append("fusion: never initialised (no LiDAR results with the IMU between them)")
+            degenerate = s.get("degenerate", 0)
+            why = (
+                f"{degenerate} of {s['processed']} scans had a degenerate direction, and the filter starts from "
+                "scans that constrain every direction"
+                if degenerate
+                else "no LiDAR results with the IMU between them"
+            )
+            lines.append(f"fusion: never initialised ({why}): LiDAR-only scan poses, no 100 Hz odometry")
         else:
             tilt = s["fusion"]["world_tilt_deg"]
             lines.append(

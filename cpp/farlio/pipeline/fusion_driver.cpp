@@ -23,6 +23,8 @@ constexpr double kRotationAgreementRatio = 7.57;
 constexpr double kRotationAgreementFloor_rad = 0.01;
 /// A gyro whose unit is not decided after this much time comparing it with the LiDAR gets a warning.
 constexpr double kUndecidedGyroWarning_s = 10.0;
+/// Degenerate scans that have kept the filter from starting for this long get a warning.
+constexpr double kDegenerateStartWarning_s = 2.0;
 /// Warnings kept between two take_warnings calls; later ones are left out (a last one says so).
 constexpr std::size_t kMaxPendingWarnings = 100;
 
@@ -337,6 +339,15 @@ void FusionDriver::link(const Scan& scan, OdometryFrame& frame) {
     // filter starts from a run of scans that constrain every direction
     fusion_->restart_window();
     frame.drop_reason = "not fused: the filter is not initialised from a scan with a degenerate direction";
+    if (!first_degenerate_start_ns_) first_degenerate_start_ns_ = stamp_ns;
+    if (!warned_degenerate_start_ &&
+        ns_to_seconds(stamp_ns - *first_degenerate_start_ns_) > kDegenerateStartWarning_s) {
+      warn("the filter has not started after " + seconds_text(kDegenerateStartWarning_s) +
+           " s of scans that do not constrain every direction (degenerate: a narrow field of view, a corridor, "
+           "a sparse LiDAR at speed): the odometry is LiDAR-only, without the 100 Hz output, until the scans "
+           "constrain every direction");
+      warned_degenerate_start_ = true;
+    }
   }
   if (frame.drop_reason.empty() && fusion_ && has_imu()) {
     Eigen::Vector3d velocity = Eigen::Vector3d::Zero();

@@ -27,7 +27,10 @@
 //     ends the fusion (LiDAR-only): fusion/gyro_unit_detector.hpp; a unit still undecided after
 //     kUndecidedGyroWarning_s of scans is a warning;
 //   results before the first IMU sample are not fused (no IMU yet: LiDAR-only until it comes),
-//     with that drop reason and one warning.
+//     with that drop reason and one warning;
+//   a result with a degenerate translation does not initialise the filter (its pose says nothing
+//     of the velocity along that direction): it restarts the initialisation window, with that drop
+//     reason, and after kDegenerateStartWarning_s of them without a filter, one warning.
 #include <cstdint>
 #include <deque>
 #include <optional>
@@ -156,6 +159,8 @@ class FusionDriver {
   std::optional<std::int64_t> first_compared_ns_;  ///< the first scan the gyro's unit was compared at
   bool gyro_follows_lidar_ = false;                ///< the gyro turned as the LiDAR between the last two scans
   bool warned_undecided_gyro_ = false;
+  std::optional<std::int64_t> first_degenerate_start_ns_;  ///< the first degenerate scan before the filter
+  bool warned_degenerate_start_ = false;
   std::int64_t clock_ns_ = 0;
   std::int64_t next_output_ns_ = 0;  ///< 0: set by the first IMU sample
   std::optional<std::int64_t> last_output_ns_;
