@@ -64,12 +64,14 @@ def test_lio_is_never_worse_than_lidar_only_at_racing_speed(tmp_path, seed):
         assert lio[metric] <= lidar[metric], (metric, lio, lidar)
 
 
-@pytest.mark.parametrize("seed", [1, 2])
+@pytest.mark.parametrize("seed", [1, 2, 3, 4])
 def test_a_forward_livox_on_the_racetrack_is_no_worse_than_lidar_only(seed):
     """A forward-looking Livox Avia model on the racetrack (20 s from a standstill): nearly every scan
     is degenerate along the track, so the filter is never started from them and the IMU serves only
-    the scans' guess and undistortion: the scan poses are no worse than LiDAR-only's (APE 0.046-0.050
-    m against 0.065-0.075 m), where a filter started from such scans ran 1.7-23 m off."""
+    the scans' guess and undistortion: the scan poses are no worse than LiDAR-only's (APE 0.041-0.062
+    m against 0.063-0.077 m), where a filter started from such scans ran 1.7-23 m off. The gyro's unit
+    is judged on scans that constrain every direction only: the rotations of the degenerate ones once
+    added up to a turn the gyro did not follow, and a "dead gyro" verdict ended the fusion (seeds 3-4)."""
     from farlio.simulation import Recording, make_config, replay, stretch_accuracy
 
     rec = Recording(make_config("racetrack", seed=seed, duration_s=20.0, lidar="avia"))
@@ -77,3 +79,4 @@ def test_a_forward_livox_on_the_racetrack_is_no_worse_than_lidar_only(seed):
     print(f"racetrack Avia seed {seed}: LIO {lio}, LiDAR-only {lidar_only}")
     assert lio["ape_m"] <= lidar_only["ape_m"] and lio["rpe_pct"] <= lidar_only["rpe_pct"], (lio, lidar_only)
     assert lio["failed"] == lio["map_restarts"] == 0, lio
+    assert lio.get("reinit") == 0, f"the fusion ended or re-initialised: {lio}"

@@ -308,8 +308,12 @@ void FusionDriver::link(const Scan& scan, OdometryFrame& frame) {
       warned_no_imu_ = true;
     }
   }
+  // the gyro's unit is judged against scans that constrain every direction: the rotations of a
+  // degenerate scan (a narrow field of view sliding along the track) carry errors that add up to a
+  // turn the gyro did not make
+  const bool constrained = !frame.degeneracy || !frame.degeneracy->degenerate();
   if (frame.drop_reason.empty() && fusion_ && has_imu() && !gyro_unit_.decided() && last_body_ &&
-      stamp_ns > last_body_->stamp_ns) {
+      stamp_ns > last_body_->stamp_ns && constrained) {
     const Eigen::Vector3d lidar_rotation = so3_log((last_body_->pose.inverse() * frame.body_pose).rotation());
     const auto gyro_rotation = fusion_->imu_rotation(last_body_->stamp_ns, stamp_ns);
     gyro_follows_lidar_ =
