@@ -7,12 +7,12 @@
 #include <nanobind/stl/vector.h>
 
 #include "bindings.hpp"
-#include "farlio/core/device.hpp"
 #include "farlio/core/se3.hpp"
 #include "farlio/core/time.hpp"
 #include "farlio/core/trajectory.hpp"
 #include "farlio/core/types.hpp"
 #include "farlio/fusion/euler.hpp"
+#include "farlio/pipeline/backend_availability.hpp"
 #include "repr.hpp"
 
 namespace nb = nanobind;
