@@ -15,9 +15,9 @@
 #include "farlio/map/voxel_map.hpp"
 #include "farlio/map/voxel_update.hpp"
 #include "farlio/pipeline/cpu_scan_backend.hpp"
-#include "farlio/pipeline/preprocess.hpp"
 #include "farlio/pipeline/scan_pipeline.hpp"
 #include "farlio/pipeline/stage_limits.hpp"
+#include "farlio/preprocess/preprocess.hpp"
 #include "farlio/registration/gicp.hpp"
 #include "farlio/sim/sequence_generator.hpp"
 
@@ -44,9 +44,9 @@ const std::vector<Scan>& urban_scans() {
 /// A scan downsampled to the map spacing, in the sensor frame (what the map and GICP see).
 std::vector<Eigen::Vector3f> downsampled(const Scan& scan, exec::CpuExecutor& ex) {
   Config cfg;
-  const auto cropped = pipeline::crop_by_range(scan.points, cfg.preprocess);
+  const auto cropped = preprocess::crop_by_range(scan.points, cfg.preprocess);
   const auto kept =
-      pipeline::voxel_downsample(scan.points, cropped, static_cast<float>(map::point_spacing_m(cfg.map)), ex);
+      preprocess::voxel_downsample(scan.points, cropped, static_cast<float>(map::point_spacing_m(cfg.map)), ex);
   std::vector<Eigen::Vector3f> out;
   for (auto i : kept) out.push_back(scan.points[static_cast<std::size_t>(i)]);
   return out;

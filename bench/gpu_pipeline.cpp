@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "farlio/io/point_cloud_io.hpp"
+#include "farlio/pipeline/backend_availability.hpp"
 #include "farlio/pipeline/scan_pipeline.hpp"
 #include "farlio/sim/sequence_generator.hpp"
 #ifdef FARLIO_WITH_CUDA

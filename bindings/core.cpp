@@ -7,12 +7,12 @@
 #include <nanobind/stl/vector.h>
 
 #include "bindings.hpp"
-#include "farlio/core/device.hpp"
 #include "farlio/core/se3.hpp"
 #include "farlio/core/time.hpp"
 #include "farlio/core/trajectory.hpp"
 #include "farlio/core/types.hpp"
 #include "farlio/fusion/euler.hpp"
+#include "farlio/pipeline/backend_availability.hpp"
 #include "repr.hpp"
 
 namespace nb = nanobind;
@@ -68,9 +68,8 @@ std::string trajectory_repr(const Trajectory& t) {
       .str();
 }
 
-}  // namespace
-
-void bind_core(nb::module_& m) {
+/// Scan: points and per-point arrays as numpy views.
+void bind_scan(nb::module_& m) {
   nb::class_<Scan>(m, "Scan", "One LiDAR scan: float32 points with per-point times (s since scan start).")
       .def(
           "__init__",
@@ -105,7 +104,10 @@ void bind_core(nb::module_& m) {
       .def_prop_ro("duration_s", &Scan::duration_s)
       .def("remove_non_finite", &Scan::remove_non_finite, "Drops NaN/Inf points; returns how many.")
       .def("__repr__", &scan_repr);
+}
 
+/// ImuSample.
+void bind_imu_sample(nb::module_& m) {
   nb::class_<ImuSample>(m, "ImuSample", "One IMU reading in the body frame.")
       .def(nb::init<>())
       .def(
@@ -118,7 +120,10 @@ void bind_core(nb::module_& m) {
       .def_rw("gyro_rad_s", &ImuSample::gyro_rad_s)
       .def_rw("accel_m_s2", &ImuSample::accel_m_s2)
       .def("__repr__", attribute_repr({"stamp_ns", "gyro_rad_s", "accel_m_s2"}));
+}
 
+/// SE3 and rotation_from_euler.
+void bind_se3(nb::module_& m) {
   m.def("rotation_from_euler", &fusion::rotation_from_euler, "rpy_rad"_a,
         "Rotation matrix (body -> world) of [roll, pitch, yaw] in radians: Rz(yaw) Ry(pitch) Rx(roll).");
   nb::class_<SE3>(m, "SE3", "Rigid transform; tangent vectors are [translation; rotation].")
@@ -139,7 +144,10 @@ void bind_core(nb::module_& m) {
       .def("__mul__", [](const SE3& a, const SE3& b) { return a * b; })
       .def("__mul__", [](const SE3& a, const Vec3d& p) { return Vec3d(a * p); })
       .def("__repr__", [](const SE3& t) { return repr_value(t); });
+}
 
+/// Trajectory.
+void bind_trajectory(nb::module_& m) {
   nb::class_<Trajectory>(m, "Trajectory", "Time-ordered poses of one frame in the world.")
       .def(nb::init<>())
       .def("push_back", &Trajectory::push_back, "stamp_ns"_a, "pose"_a)
@@ -176,7 +184,15 @@ void bind_core(nb::module_& m) {
       .def("path_length_m", &Trajectory::path_length_m)
       .def("is_time_ordered", &Trajectory::is_time_ordered)
       .def("__repr__", &trajectory_repr);
+}
 
+}  // namespace
+
+void bind_core(nb::module_& m) {
+  bind_scan(m);
+  bind_imu_sample(m);
+  bind_se3(m);
+  bind_trajectory(m);
   m.attr("NS_PER_S") = kNsPerSecond;  // stamps are integer ns
   m.def("cuda_compiled", &cuda_compiled, "True if this build contains the CUDA backend.");
   m.def("cuda_device_count", &cuda_device_count, "Number of usable CUDA devices.");

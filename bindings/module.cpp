@@ -15,5 +15,13 @@ NB_MODULE(_core, m) {
   farlio::python::bind_sim(sim);
   auto ev = m.def_submodule("eval", "trajectory evaluation: APE, RPE, coverage");
   farlio::python::bind_eval(ev);
-  farlio::python::bind_pipeline(m);
+  farlio::python::bind_config(m);
+  farlio::python::bind_stage_limits(m);
+  farlio::python::bind_scan_results(m);
+  farlio::python::bind_registration(m);
+  farlio::python::bind_clock_check(m);
+  farlio::python::bind_odometry(m);
+  farlio::python::bind_map_export(m);
+  farlio::python::bind_online_odometry(m);
+  farlio::python::bind_scan_pipeline(m);
 }

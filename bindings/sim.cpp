@@ -14,9 +14,10 @@ namespace nb = nanobind;
 using namespace nb::literals;
 
 namespace farlio::python {
-namespace {}  // namespace
+namespace {
 
-void bind_sim(nb::module_& m) {
+/// The profiles and LiDAR models, with their names.
+void bind_profiles(nb::module_& m) {
   using namespace farlio::sim;
   nb::enum_<Profile>(m, "Profile")
       .value("Racetrack", Profile::Racetrack)
@@ -35,7 +36,11 @@ void bind_sim(nb::module_& m) {
   m.def("parse_lidar_model", &parse_lidar_model, "name"_a,
         "'profile' | 'avia' | 'mid360' | 'vlp16' | 'hdl32' | 'os128' (docs/simulation.md, 'LiDAR models').");
   m.def("lidar_model_name", &lidar_model_name, "model"_a);
+}
 
+/// The sensors' noise and the IMU error model: configs, a run's draw, the datasheet grades.
+void bind_imu_errors(nb::module_& m) {
+  using namespace farlio::sim;
   nb::class_<NoiseConfig>(m, "NoiseConfig", "LiDAR and IMU noise of a simulated sequence.")
       .def(nb::init<>())
       .def_rw("range_noise_std_m", &NoiseConfig::range_noise_std_m)
@@ -86,7 +91,11 @@ void bind_sim(nb::module_& m) {
       .value("Tactical", ImuGrade::Tactical);
   m.def("parse_imu_grade", &parse_imu_grade, "name"_a, "'profile' | 'ideal' | 'consumer' | 'industrial' | 'tactical'.");
   m.def("imu_grade_name", &imu_grade_name, "grade"_a);
+}
 
+/// SimConfig and its defaults per profile.
+void bind_sim_config(nb::module_& m) {
+  using namespace farlio::sim;
   nb::class_<SimConfig>(m, "SimConfig", "Profile, seed, duration, noise and rates; see default_config().")
       .def(nb::init<>())
       .def_rw("profile", &SimConfig::profile)
@@ -115,7 +124,11 @@ void bind_sim(nb::module_& m) {
       "config"_a, "grade"_a, "vibration"_a = true,
       "A copy of config with the IMU set to a grade (profile: unchanged; ideal: no IMU error; consumer, industrial, "
       "tactical: datasheet classes plus the profile's vibration unless vibration=False).");
+}
 
+/// BodyState and SequenceGenerator.
+void bind_sequence_generator(nb::module_& m) {
+  using namespace farlio::sim;
   nb::class_<BodyState>(m, "BodyState", "Exact state of the body (IMU) frame.")
       .def_ro("pose_world_body", &BodyState::pose_world_body)
       .def_ro("velocity_world_m_s", &BodyState::velocity_world_m_s)
@@ -175,6 +188,15 @@ void bind_sim(nb::module_& m) {
       .def("scan_period_ns", &SequenceGenerator::scan_period_ns)
       .def("description", &SequenceGenerator::description)
       .def_prop_ro("config", &SequenceGenerator::config);
+}
+
+}  // namespace
+
+void bind_sim(nb::module_& m) {
+  bind_profiles(m);
+  bind_imu_errors(m);
+  bind_sim_config(m);
+  bind_sequence_generator(m);
 }
 
 }  // namespace farlio::python

@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # Checks that the tree has the project's style: clang-format (.clang-format) on the C++ and CUDA
-# sources, ruff's formatter and linter (pyproject.toml) on the Python, and no line over 120
-# columns in either. `--fix` rewrites the files instead. Part of scripts/test.sh (CI).
+# sources, ruff's formatter and linter (pyproject.toml) on the Python, no line over 120 columns in
+# either, and no function over 80 lines outside the tests (scripts/check_function_length.py).
+# `--fix` rewrites the files instead (function lengths are not fixed). Part of scripts/test.sh (CI).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 RUFF=${RUFF:-.venv/bin/ruff}
+PYTHON=${PYTHON:-python3}
 MAX_COLUMNS=120
 mapfile -t cpp < <(git ls-files '*.cpp' '*.hpp' '*.cu' '*.cuh')
 mapfile -t py < <(git ls-files '*.py')
@@ -21,6 +23,7 @@ clang-format --dry-run -Werror "${cpp[@]}" || { echo "C++: run scripts/check_for
 "$RUFF" format --check --quiet . || { echo "Python: run scripts/check_format.sh --fix"; status=1; }
 "$RUFF" check --quiet . || status=1
 long=$(awk -v max="$MAX_COLUMNS" 'length > max {print FILENAME ":" FNR ": " length " columns"}' "${cpp[@]}" "${py[@]}")
+"$PYTHON" scripts/check_function_length.py || status=1
 if [ -n "$long" ]; then
   echo "lines over $MAX_COLUMNS columns:"
   echo "$long"

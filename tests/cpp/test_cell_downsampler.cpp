@@ -12,7 +12,7 @@
 #include "farlio/exec/cpu_executor.hpp"
 #include "farlio/map/voxel_key.hpp"
 #include "farlio/map/voxel_update.hpp"
-#include "farlio/pipeline/cell_downsampler.hpp"
+#include "farlio/preprocess/cell_downsampler.hpp"
 
 using namespace farlio;
 
@@ -49,7 +49,7 @@ class CellDownsamplerTest : public ::testing::TestWithParam<int> {};
 
 TEST_P(CellDownsamplerTest, EqualsTheLowestIndexOfEachCellInKeyOrder) {
   exec::CpuExecutor ex(GetParam());
-  pipeline::CellDownsampler d;
+  preprocess::CellDownsampler d;
   for (std::uint32_t seed = 1; seed <= 3; ++seed) {
     auto keys = ring_scan_keys(0.63f, seed);
     EXPECT_EQ(d.first_of_each_cell(keys.data(), keys.size(), ex), reference(keys)) << "ordered, seed " << seed;
@@ -60,7 +60,7 @@ TEST_P(CellDownsamplerTest, EqualsTheLowestIndexOfEachCellInKeyOrder) {
 
 TEST_P(CellDownsamplerTest, GrowsWhenEveryPointHasItsOwnCellAndShrinksBackCorrectly) {
   exec::CpuExecutor ex(GetParam());
-  pipeline::CellDownsampler d;
+  preprocess::CellDownsampler d;
   const auto coarse = ring_scan_keys(4.0f, 7);  // few cells: a small table
   EXPECT_EQ(d.first_of_each_cell(coarse.data(), coarse.size(), ex), reference(coarse));
   std::vector<std::uint64_t> distinct;  // 64k cells, far more than the table was sized for

@@ -4,6 +4,7 @@
 
 #include "farlio/core/config_fields.hpp"
 #include "farlio/core/device.hpp"
+#include "farlio/pipeline/backend_availability.hpp"
 #include "farlio/pipeline/scan_pipeline.hpp"
 
 using namespace farlio;

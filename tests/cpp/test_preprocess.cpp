@@ -12,8 +12,8 @@
 #include "farlio/deskew/scan_motion.hpp"
 #include "farlio/map/voxel_update.hpp"
 #include "farlio/pipeline/cpu_scan_backend.hpp"
-#include "farlio/pipeline/preprocess_point.hpp"
-#include "farlio/pipeline/range_crop.hpp"
+#include "farlio/preprocess/preprocess_point.hpp"
+#include "farlio/preprocess/range_crop.hpp"
 
 using namespace farlio;
 
@@ -60,9 +60,9 @@ TEST(Preprocess, KeepsTheFirstRawPointOfEachCellUndistorted) {
       const std::vector<Eigen::Vector3f> frame = backend.frame_points();
       ASSERT_EQ(frame.size(), kept);
       // brute force: cells of the raw positions, the first index of each, in key order
-      const pipeline::PreprocessParams pp{pipeline::RangeCrop::from(cfg.preprocess),
-                                          deskew::DeskewTable::sample(motion, static_cast<float>(kDuration_s)),
-                                          undistort, static_cast<float>(1.0 / map::point_spacing_m(cfg.map))};
+      const preprocess::PreprocessParams pp{preprocess::RangeCrop::from(cfg.preprocess),
+                                            deskew::DeskewTable::sample(motion, static_cast<float>(kDuration_s)),
+                                            undistort, static_cast<float>(1.0 / map::point_spacing_m(cfg.map))};
       std::map<std::uint64_t, std::size_t> first;
       for (std::size_t i = 0; i < ms.scan.size(); ++i) {
         if (!pp.crop.keeps(ms.scan.points[i])) continue;
@@ -73,7 +73,7 @@ TEST(Preprocess, KeepsTheFirstRawPointOfEachCellUndistorted) {
       std::size_t k = 0;
       double worst_m = 0.0;
       for (const auto& [key, i] : first) {
-        const Eigen::Vector3f expected = pipeline::undistorted_point(ms.scan.points[i], ms.scan.time_s[i], pp);
+        const Eigen::Vector3f expected = preprocess::undistorted_point(ms.scan.points[i], ms.scan.time_s[i], pp);
         ASSERT_EQ(frame[k], expected) << "cell " << k;
         worst_m = std::max(worst_m, (frame[k].cast<double>() - ms.in_end_frame[i]).norm());
         ++k;

@@ -13,9 +13,9 @@
 #include "farlio/map/neighbor_search.hpp"
 #include "farlio/map/voxel_map.hpp"
 #include "farlio/map/voxel_update.hpp"
-#include "farlio/pipeline/downsampling_keys.hpp"
-#include "farlio/pipeline/preprocess_point.hpp"
-#include "farlio/pipeline/range_crop.hpp"
+#include "farlio/preprocess/downsampling_keys.hpp"
+#include "farlio/preprocess/preprocess_point.hpp"
+#include "farlio/preprocess/range_crop.hpp"
 #include "farlio/registration/factor_sums.hpp"
 #include "farlio/registration/gicp.hpp"
 #include "scene_fixture.hpp"
@@ -70,7 +70,7 @@ TEST(SharedBodies, RangeCropKeepsTheClosedInterval) {
   PreprocessConfig c;
   c.min_range_m = 1.0;
   c.max_range_m = 10.0;
-  const auto crop = pipeline::RangeCrop::from(c);
+  const auto crop = preprocess::RangeCrop::from(c);
   EXPECT_TRUE(crop.keeps({1.0f, 0, 0}));
   EXPECT_TRUE(crop.keeps({0, 10.0f, 0}));
   EXPECT_FALSE(crop.keeps({0.5f, 0, 0}));
@@ -90,7 +90,7 @@ TEST(SharedBodies, DownsamplingKeysOfTheCpuEqualThePerPointBody) {
     PreprocessConfig c;
     c.min_range_m = 1.0;
     c.max_range_m = 100.0;
-    pipeline::PreprocessParams pp{pipeline::RangeCrop::from(c), {}, false, 1.0f / cell_m};
+    preprocess::PreprocessParams pp{preprocess::RangeCrop::from(c), {}, false, 1.0f / cell_m};
     std::vector<Vec3f> pts;
     for (int i = 0; i < 20000; ++i) {
       Vec3f p(u(rng), u(rng), 0.2f * u(rng));
@@ -108,9 +108,9 @@ TEST(SharedBodies, DownsamplingKeysOfTheCpuEqualThePerPointBody) {
     }
     for (const std::size_t n : {pts.size(), std::size_t{7}, std::size_t{3}, std::size_t{0}}) {
       std::vector<std::uint64_t> batch(n, 0);
-      pipeline::downsampling_keys(pts.data(), n, pp, batch.data());
+      preprocess::downsampling_keys(pts.data(), n, pp, batch.data());
       for (std::size_t i = 0; i < n; ++i) {
-        ASSERT_EQ(batch[i], pipeline::downsampling_key(pts[i], pp)) << pts[i].transpose() << " cell " << cell_m;
+        ASSERT_EQ(batch[i], preprocess::downsampling_key(pts[i], pp)) << pts[i].transpose() << " cell " << cell_m;
       }
     }
   }

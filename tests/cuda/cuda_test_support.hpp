@@ -6,12 +6,12 @@
 #include <memory>
 #include <vector>
 
-#include "farlio/core/device.hpp"
 #include "farlio/cuda/cuda_executor.hpp"
 #include "farlio/cuda/device_algorithms.hpp"
 #include "farlio/cuda/device_buffer.hpp"
 #include "farlio/cuda/device_voxel_map.hpp"
 #include "farlio/cuda/map_scratch.hpp"
+#include "farlio/pipeline/backend_availability.hpp"
 
 #define FARLIO_REQUIRE_GPU()                                                  \
   do {                                                                        \

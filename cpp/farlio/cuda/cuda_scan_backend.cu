@@ -9,7 +9,7 @@
 #include "farlio/cuda/map_scratch.hpp"
 #include "farlio/cuda/stage_timer.hpp"
 #include "farlio/map/voxel_update.hpp"
-#include "farlio/pipeline/preprocess_point.hpp"
+#include "farlio/preprocess/preprocess_point.hpp"
 #include "farlio/registration/factor_sums.hpp"
 
 namespace farlio::cuda {
@@ -86,12 +86,12 @@ class CudaScanBackend final : public pipeline::ScanBackend {
   /// Crop and the keys of the downsampling cells (one thread a point), then the first point of
   /// each cell in (cell key, input order), undistorted, as CpuScanBackend::preprocess.
   std::size_t downsample(std::size_t n, const deskew::DeskewTable& motion, bool undistort) {
-    const pipeline::PreprocessParams pp{pipeline::RangeCrop::from(config_.preprocess), motion, undistort,
-                                        1.0f / map_.spacing_m()};
+    const preprocess::PreprocessParams pp{preprocess::RangeCrop::from(config_.preprocess), motion, undistort,
+                                          1.0f / map_.spacing_m()};
     const Eigen::Vector3f* raw = raw_.data();
     const float* times = times_.data();
     std::uint64_t* keys = scratch_.keys.data();
-    executor_.for_each(n, [=] __device__(std::size_t i) { keys[i] = pipeline::downsampling_key(raw[i], pp); });
+    executor_.for_each(n, [=] __device__(std::size_t i) { keys[i] = preprocess::downsampling_key(raw[i], pp); });
     std::size_t valid = 0;
     // the crop keeps points within max_range_m of the sensor: their cells sort on short keys
     const auto window = map::KeyWindow::around(Eigen::Vector3d::Zero(), config_.preprocess.max_range_m,
@@ -102,7 +102,7 @@ class CudaScanBackend final : public pipeline::ScanBackend {
     Eigen::Vector3f* frame = frame_.data();
     executor_.for_each(kept, [=] __device__(std::size_t g) {
       const std::int32_t i = order[starts[g]];
-      frame[g] = pipeline::undistorted_point(raw[i], undistort ? times[i] : 0.0f, pp);
+      frame[g] = preprocess::undistorted_point(raw[i], undistort ? times[i] : 0.0f, pp);
     });
     return kept;
   }

@@ -1,4 +1,4 @@
-// The CUDA runtime query behind farlio::cuda_device_count (cpp/farlio/core/device.hpp).
+// The CUDA runtime query behind farlio::cuda_device_count (cpp/farlio/pipeline/backend_availability.hpp).
 #include <cuda_runtime.h>
 
 namespace farlio {

@@ -39,6 +39,95 @@ std::int32_t read_scalar(const std::int32_t* device_value, cudaStream_t stream) 
   return v;
 }
 
+/// Each group's stored voxel (-1 when missing) and, in key order, the rank of each missing one
+/// (an exclusive sum of the misses); returns how many are missing.
+std::size_t find_group_voxels(const map::MapView& v, MapScratch& s, CudaExecutor& ex, DeviceAlgorithms& algorithms,
+                              std::size_t groups) {
+  const std::uint64_t* sorted_keys = s.sorted_keys.data();
+  const std::int32_t* group_start = s.group_start.data();
+  std::int32_t* group_voxel = s.group_voxel.data();
+  std::int32_t* missing = s.missing.data();
+  std::int32_t* rank = s.rank.data();
+  ex.for_each(groups, [=] __device__(std::size_t g) {
+    const std::uint64_t key = sorted_keys[group_start[g]];
+    const std::int32_t vox = map::table_find(v, key, map::spatial_hash(map::unpack_key(key)));
+    group_voxel[g] = vox;
+    missing[g] = vox < 0 ? 1 : 0;
+    if (g == 0) missing[groups] = 0;  // one more element: rank[groups] is the number of misses
+  });
+  algorithms.exclusive_sum(missing, rank, groups + 1);
+  return static_cast<std::size_t>(read_scalar(rank + groups, ex.stream()));
+}
+
+/// A new voxel for each missing group, in the host's allocation order (voxel_pool.hpp), one
+/// thread a group; a voxel the table has no slot for counts in `table_full`.
+void add_group_voxels(const map::MapView& v, MapScratch& s, CudaExecutor& ex, std::size_t groups,
+                      const std::int32_t* free_list, std::size_t free_count, std::size_t from_free_list,
+                      std::size_t high_water, std::int32_t* table_full) {
+  const std::uint64_t* sorted_keys = s.sorted_keys.data();
+  const std::int32_t* group_start = s.group_start.data();
+  std::int32_t* group_voxel = s.group_voxel.data();
+  const std::int32_t* missing = s.missing.data();
+  const std::int32_t* rank = s.rank.data();
+  ex.for_each(groups, [=] __device__(std::size_t g) {
+    if (!missing[g]) return;
+    const std::int32_t vox = map::new_voxel_slot(rank[g], free_list, free_count, from_free_list, high_water);
+    group_voxel[g] = vox;
+    if (!map::add_voxel(v, sorted_keys[group_start[g]], vox)) exec::atomic_add(table_full, 1);
+  });
+}
+
+/// Inserts each voxel's candidates in order, with the cap and the spacing (one thread a voxel),
+/// and sums the groups' counts (the covariances to compute when `compute`) with the table's
+/// failed insertions.
+InsertTotals insert_groups(const map::MapView& v, MapScratch& s, CudaExecutor& ex, const Eigen::Vector3f* points,
+                           std::size_t groups, const map::InsertParams& ip, bool compute, bool refresh,
+                           const std::int32_t* table_full) {
+  const std::int32_t* order = s.sorted_order.data();
+  const std::int32_t* group_start = s.group_start.data();
+  const std::int32_t* group_voxel = s.group_voxel.data();
+  std::int32_t* first_new = s.first_new.data();
+  map::GroupStats* gstats = s.group_stats.data();
+  ex.for_each(groups, [=] __device__(std::size_t g) {
+    const auto candidate = [=](std::int64_t c) { return points[order[c]]; };
+    gstats[g] =
+        map::insert_voxel_group(v, group_voxel[g], candidate, group_start[g], group_start[g + 1], ip, &first_new[g]);
+  });
+  return ex.reduce(
+      groups, InsertTotals{},
+      [=] __device__(std::size_t g) {
+        InsertTotals t;
+        t.inserted = gstats[g].inserted;
+        t.spacing = gstats[g].spacing;
+        t.full = gstats[g].full;
+        t.covariances =
+            compute ? map::covariance_points(v.voxel_counts[group_voxel[g]], first_new[g], refresh).size() : 0;
+        if (g == 0) t.table_full = *table_full;
+        return t;
+      },
+      Add{});
+}
+
+/// Covariances of the new points (or of every point of a changed voxel): one thread a point slot
+/// of each group's voxel (the CPU runs the same body in a loop, one task a voxel).
+void update_group_covariances(const map::MapView& v, MapScratch& s, CudaExecutor& ex, std::size_t groups,
+                              const VoxelMapConfig& config, bool refresh) {
+  const std::int32_t* group_voxel = s.group_voxel.data();
+  const std::int32_t* first_new = s.first_new.data();
+  const int k = config.covariance_neighbors;
+  const auto eps = static_cast<float>(config.covariance_epsilon);
+  const auto line_ratio = static_cast<float>(config.line_eigenvalue_ratio);
+  const auto slots = static_cast<std::size_t>(config.max_points_per_voxel);
+  ex.for_each(groups * slots, [=] __device__(std::size_t i) {
+    const std::size_t g = i / slots;
+    const auto j = static_cast<std::int32_t>(i % slots);
+    const std::int32_t vox = group_voxel[g];
+    const map::PointRange r = map::covariance_points(v.voxel_counts[vox], first_new[g], refresh);
+    if (j < r.begin || j >= r.end) return;
+    map::update_point_covariance(v, vox, j, k, eps, line_ratio);
+  });
+}
+
 }  // namespace
 
 DeviceVoxelMap::DeviceVoxelMap(const VoxelMapConfig& config, std::size_t voxel_capacity, std::string capacity_parameter,
@@ -143,20 +232,7 @@ map::InsertStats DeviceVoxelMap::insert(const Eigen::Vector3f* points, std::size
 
   // 2. find existing voxels; new ones are numbered in key order (exclusive sum of the misses)
   const map::MapView v = view();
-  const std::uint64_t* sorted_keys = s.sorted_keys.data();
-  const std::int32_t* group_start = s.group_start.data();
-  std::int32_t* group_voxel = s.group_voxel.data();
-  std::int32_t* missing = s.missing.data();
-  std::int32_t* rank = s.rank.data();
-  ex.for_each(groups, [=] __device__(std::size_t g) {
-    const std::uint64_t key = sorted_keys[group_start[g]];
-    const std::int32_t vox = map::table_find(v, key, map::spatial_hash(map::unpack_key(key)));
-    group_voxel[g] = vox;
-    missing[g] = vox < 0 ? 1 : 0;
-    if (g == 0) missing[groups] = 0;  // one more element: rank[groups] is the number of misses
-  });
-  algorithms_->exclusive_sum(missing, rank, groups + 1);
-  const auto new_voxels = static_cast<std::size_t>(read_scalar(rank + groups, ex.stream()));
+  const std::size_t new_voxels = find_group_voxels(v, s, ex, *algorithms_, groups);
   FARLIO_CUDA_CHECK(cudaMemsetAsync(s.scalars.data(), 0, s.scalars.bytes(), ex.stream()));
   std::int32_t* table_full = s.scalars.data() + kScalarTableFull;
   if (new_voxels > 0) {
@@ -167,15 +243,7 @@ map::InsertStats DeviceVoxelMap::insert(const Eigen::Vector3f* points, std::size
       }
       rehash();
     }
-    // the host's allocation order (voxel_pool.hpp), one thread a group
-    const std::int32_t* free_list = free_voxels_.data();
-    const std::size_t free_count = free_count_, from_free_list = plan.from_free_list, high_water = high_water_;
-    ex.for_each(groups, [=] __device__(std::size_t g) {
-      if (!missing[g]) return;
-      const std::int32_t vox = map::new_voxel_slot(rank[g], free_list, free_count, from_free_list, high_water);
-      group_voxel[g] = vox;
-      if (!map::add_voxel(v, sorted_keys[group_start[g]], vox)) exec::atomic_add(table_full, 1);
-    });
+    add_group_voxels(v, s, ex, groups, free_voxels_.data(), free_count_, plan.from_free_list, high_water_, table_full);
     free_count_ -= plan.from_free_list;
     high_water_ = plan.high_water;
     live_voxels_ += new_voxels;
@@ -183,31 +251,11 @@ map::InsertStats DeviceVoxelMap::insert(const Eigen::Vector3f* points, std::size
     stats.new_voxels = new_voxels;
   }
 
-  // 3. insert each voxel's candidates in order, with the cap and the spacing (one thread a voxel)
-  const map::InsertParams ip{origin, limit, spacing_m_ * spacing_m_};
-  const std::int32_t* order = s.sorted_order.data();
-  std::int32_t* first_new = s.first_new.data();
-  map::GroupStats* gstats = s.group_stats.data();
-  ex.for_each(groups, [=] __device__(std::size_t g) {
-    const auto candidate = [=](std::int64_t c) { return points[order[c]]; };
-    gstats[g] =
-        map::insert_voxel_group(v, group_voxel[g], candidate, group_start[g], group_start[g + 1], ip, &first_new[g]);
-  });
+  // 3. insert each voxel's candidates in order, with the cap and the spacing
   const bool refresh = config_.refresh_covariances;
   const bool compute = covariances == map::CovarianceUpdate::Compute;
-  const InsertTotals totals = ex.reduce(
-      groups, InsertTotals{},
-      [=] __device__(std::size_t g) {
-        InsertTotals t;
-        t.inserted = gstats[g].inserted;
-        t.spacing = gstats[g].spacing;
-        t.full = gstats[g].full;
-        t.covariances =
-            compute ? map::covariance_points(v.voxel_counts[group_voxel[g]], first_new[g], refresh).size() : 0;
-        if (g == 0) t.table_full = *table_full;
-        return t;
-      },
-      Add{});
+  const map::InsertParams ip{origin, limit, spacing_m_ * spacing_m_};
+  const InsertTotals totals = insert_groups(v, s, ex, points, groups, ip, compute, refresh, table_full);
   if (totals.table_full > 0) {
     throw CapacityError("CUDA backend: the voxel table is full; raise " + capacity_parameter_);
   }
@@ -216,22 +264,8 @@ map::InsertStats DeviceVoxelMap::insert(const Eigen::Vector3f* points, std::size
   stats.rejected_full = static_cast<std::size_t>(totals.full);
   stats.covariances_computed = static_cast<std::size_t>(totals.covariances);
 
-  // 4. covariances of the new points (or of every point of a changed voxel): one thread a point
-  //    slot of each group's voxel (the CPU runs the same body in a loop, one task a voxel)
-  if (totals.covariances > 0) {
-    const int k = config_.covariance_neighbors;
-    const auto eps = static_cast<float>(config_.covariance_epsilon);
-    const auto line_ratio = static_cast<float>(config_.line_eigenvalue_ratio);
-    const auto slots = static_cast<std::size_t>(config_.max_points_per_voxel);
-    ex.for_each(groups * slots, [=] __device__(std::size_t i) {
-      const std::size_t g = i / slots;
-      const auto j = static_cast<std::int32_t>(i % slots);
-      const std::int32_t vox = group_voxel[g];
-      const map::PointRange r = map::covariance_points(v.voxel_counts[vox], first_new[g], refresh);
-      if (j < r.begin || j >= r.end) return;
-      map::update_point_covariance(v, vox, j, k, eps, line_ratio);
-    });
-  }
+  // 4. covariances of the new points (or of every point of a changed voxel)
+  if (totals.covariances > 0) update_group_covariances(v, s, ex, groups, config_, refresh);
   return stats;
 }
 

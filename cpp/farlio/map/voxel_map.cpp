@@ -73,65 +73,13 @@ InsertStats VoxelMap::insert(const std::vector<Eigen::Vector3f>& points, const E
                              const PointLimit& limit, CovarianceUpdate covariances) {
   InsertStats stats;
   stats.candidates = points.size();
-  const float inv_voxel = static_cast<float>(1.0 / config_.voxel_size_m);
-
-  // 1. group candidates by voxel (groups in key order), in input order inside a voxel
-  keys_.resize(points.size());
-  executor_->for_each(points.size(), [&](std::size_t i) { keys_[i] = point_key(points[i], inv_voxel); });
-  const std::size_t groups = grouping_.group(keys_.data(), keys_.size());
+  const std::size_t groups = group_candidates(points);
   stats.out_of_range = grouping_.dropped();
-  const std::vector<std::int32_t>& order = grouping_.order();
-
-  // 2. find existing voxels, create the missing ones (serially, in key order: voxel_pool.hpp)
   std::vector<std::int32_t> group_voxel(groups);
-  {
-    const ConstMapView v = view();
-    executor_->for_each(groups, [&](std::size_t g) {
-      const std::uint64_t key = grouping_.key(g);
-      group_voxel[g] = table_find(v, key, spatial_hash(unpack_key(key)));
-    });
-  }
-  const auto missing = static_cast<std::size_t>(std::count(group_voxel.begin(), group_voxel.end(), -1));
-  if (missing > 0) {
-    reserve_voxels(voxels_needed(counts(), missing));
-    const InsertionPlan plan = plan_insertion(counts(), missing, voxel_capacity(), kCapacityParameter);
-    if (plan.rehash_slots > 0) rehash(plan.rehash_slots);
-    const MapView v = view();
-    std::int32_t rank = 0;
-    for (std::size_t g = 0; g < groups; ++g) {
-      if (group_voxel[g] >= 0) continue;
-      const std::uint64_t key = grouping_.key(g);
-      const std::int32_t vox =
-          new_voxel_slot(rank++, free_voxels_.data(), free_voxels_.size(), plan.from_free_list, high_water_);
-      group_voxel[g] = vox;
-      if (!add_voxel(v, key, vox)) {
-        throw CapacityError("voxel map hash table is full (" + std::to_string(slot_keys_.size()) + " slots)");
-      }
-    }
-    free_voxels_.resize(free_voxels_.size() - plan.from_free_list);
-    high_water_ = plan.high_water;
-    live_voxels_ += missing;
-    used_slots_ += missing;
-    stats.new_voxels = missing;
-  }
-
-  // 3. insert each voxel's candidates in order, with the cap and the spacing
-  const InsertParams ip{origin, limit, spacing_m_ * spacing_m_};
+  stats.new_voxels = find_or_add_voxels(group_voxel);
   std::vector<std::int32_t> first_new(groups);
   std::vector<GroupStats> gstats(groups);
-  {
-    const MapView v = view();
-    const auto candidate = [&](std::int64_t c) {
-      return points[static_cast<std::size_t>(order[static_cast<std::size_t>(c)])];
-    };
-    executor_->for_each(
-        groups,
-        [&](std::size_t g) {
-          gstats[g] = insert_voxel_group(v, group_voxel[g], candidate, static_cast<std::int64_t>(grouping_.start(g)),
-                                         static_cast<std::int64_t>(grouping_.start(g + 1)), ip, &first_new[g]);
-        },
-        kVoxelGrain);
-  }
+  insert_groups(points, origin, limit, group_voxel, first_new, gstats);
   const bool refresh = config_.refresh_covariances;
   const bool compute = covariances == CovarianceUpdate::Compute;
   for (std::size_t g = 0; g < groups; ++g) {
@@ -144,23 +92,82 @@ InsertStats VoxelMap::insert(const std::vector<Eigen::Vector3f>& points, const E
           covariance_points(voxel_counts_[static_cast<std::size_t>(group_voxel[g])], first_new[g], refresh).size());
     }
   }
-  if (!compute) return stats;
+  if (compute) update_group_covariances(group_voxel, first_new, refresh);
+  return stats;
+}
 
-  // 4. covariances of the new points (or of every point of a changed voxel), one task a voxel;
-  // a voxel that received none is skipped inside its task (no serial list of the changed ones)
+std::size_t VoxelMap::group_candidates(const std::vector<Eigen::Vector3f>& points) {
+  const float inv_voxel = static_cast<float>(1.0 / config_.voxel_size_m);
+  keys_.resize(points.size());
+  executor_->for_each(points.size(), [&](std::size_t i) { keys_[i] = point_key(points[i], inv_voxel); });
+  return grouping_.group(keys_.data(), keys_.size());
+}
+
+std::size_t VoxelMap::find_or_add_voxels(std::vector<std::int32_t>& group_voxel) {
+  const std::size_t groups = group_voxel.size();
+  {
+    const ConstMapView v = view();
+    executor_->for_each(groups, [&](std::size_t g) {
+      const std::uint64_t key = grouping_.key(g);
+      group_voxel[g] = table_find(v, key, spatial_hash(unpack_key(key)));
+    });
+  }
+  const auto missing = static_cast<std::size_t>(std::count(group_voxel.begin(), group_voxel.end(), -1));
+  if (missing == 0) return 0;
+  reserve_voxels(voxels_needed(counts(), missing));
+  const InsertionPlan plan = plan_insertion(counts(), missing, voxel_capacity(), kCapacityParameter);
+  if (plan.rehash_slots > 0) rehash(plan.rehash_slots);
+  const MapView v = view();
+  std::int32_t rank = 0;
+  for (std::size_t g = 0; g < groups; ++g) {
+    if (group_voxel[g] >= 0) continue;
+    const std::uint64_t key = grouping_.key(g);
+    const std::int32_t vox =
+        new_voxel_slot(rank++, free_voxels_.data(), free_voxels_.size(), plan.from_free_list, high_water_);
+    group_voxel[g] = vox;
+    if (!add_voxel(v, key, vox)) {
+      throw CapacityError("voxel map hash table is full (" + std::to_string(slot_keys_.size()) + " slots)");
+    }
+  }
+  free_voxels_.resize(free_voxels_.size() - plan.from_free_list);
+  high_water_ = plan.high_water;
+  live_voxels_ += missing;
+  used_slots_ += missing;
+  return missing;
+}
+
+void VoxelMap::insert_groups(const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& origin,
+                             const PointLimit& limit, const std::vector<std::int32_t>& group_voxel,
+                             std::vector<std::int32_t>& first_new, std::vector<GroupStats>& gstats) {
+  const InsertParams ip{origin, limit, spacing_m_ * spacing_m_};
+  const MapView v = view();
+  const std::vector<std::int32_t>& order = grouping_.order();
+  const auto candidate = [&](std::int64_t c) {
+    return points[static_cast<std::size_t>(order[static_cast<std::size_t>(c)])];
+  };
+  executor_->for_each(
+      group_voxel.size(),
+      [&](std::size_t g) {
+        gstats[g] = insert_voxel_group(v, group_voxel[g], candidate, static_cast<std::int64_t>(grouping_.start(g)),
+                                       static_cast<std::int64_t>(grouping_.start(g + 1)), ip, &first_new[g]);
+      },
+      kVoxelGrain);
+}
+
+void VoxelMap::update_group_covariances(const std::vector<std::int32_t>& group_voxel,
+                                        const std::vector<std::int32_t>& first_new, bool refresh) {
   const MapView v = view();
   const int k = config_.covariance_neighbors;
   const auto eps = static_cast<float>(config_.covariance_epsilon);
   const auto line_ratio = static_cast<float>(config_.line_eigenvalue_ratio);
   executor_->for_each(
-      groups,
+      group_voxel.size(),
       [&](std::size_t g) {
         const std::int32_t voxel = group_voxel[g];
         const PointRange r = covariance_points(v.voxel_counts[voxel], first_new[g], refresh);
         update_voxel_covariances(v, voxel, r, k, eps, line_ratio);
       },
       kVoxelGrain);
-  return stats;
 }
 
 std::size_t VoxelMap::remove_far(const Eigen::Vector3f& origin) {

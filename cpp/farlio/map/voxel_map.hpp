@@ -83,6 +83,22 @@ class VoxelMap {
   /// Grows the pool to hold `needed` voxels (doubling, up to map.max_voxel_capacity).
   void reserve_voxels(std::size_t needed);
   void rehash(std::size_t slots);
+  // The steps of insert:
+  /// 1. Groups the candidates by voxel (groups in key order, input order inside a voxel) into
+  /// grouping_; returns the number of groups.
+  std::size_t group_candidates(const std::vector<Eigen::Vector3f>& points);
+  /// 2. The voxel of each group: the stored one, or a new one for each missing voxel (created
+  /// serially, in key order: voxel_pool.hpp). Returns how many were created.
+  std::size_t find_or_add_voxels(std::vector<std::int32_t>& group_voxel);
+  /// 3. Inserts each voxel's candidates in order, with the cap and the spacing, one task a few
+  /// voxels: each group's first new point slot and counts.
+  void insert_groups(const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& origin, const PointLimit& limit,
+                     const std::vector<std::int32_t>& group_voxel, std::vector<std::int32_t>& first_new,
+                     std::vector<GroupStats>& gstats);
+  /// 4. Covariances of the new points (or of every point of a changed voxel), one task a voxel; a
+  /// voxel that received none is skipped inside its task (no serial list of the changed ones).
+  void update_group_covariances(const std::vector<std::int32_t>& group_voxel,
+                                const std::vector<std::int32_t>& first_new, bool refresh);
 
   VoxelMapConfig config_;
   exec::CpuExecutor* executor_;  // not owned (a pointer keeps the map movable)

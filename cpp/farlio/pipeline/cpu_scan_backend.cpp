@@ -1,7 +1,7 @@
 #include "farlio/pipeline/cpu_scan_backend.hpp"
 
-#include "farlio/pipeline/downsampling_keys.hpp"
-#include "farlio/pipeline/preprocess_point.hpp"
+#include "farlio/preprocess/downsampling_keys.hpp"
+#include "farlio/preprocess/preprocess_point.hpp"
 
 namespace farlio::pipeline {
 
@@ -22,19 +22,19 @@ void CpuScanBackend::reset(const Config& config) {
 }
 
 std::size_t CpuScanBackend::preprocess(const Scan& scan, const deskew::ScanMotion& motion, bool undistort) {
-  const PreprocessParams pp{RangeCrop::from(config_.preprocess),
-                            deskew::DeskewTable::sample(motion, static_cast<float>(scan.duration_s())), undistort,
-                            1.0f / map_.spacing_m()};
+  const preprocess::PreprocessParams pp{preprocess::RangeCrop::from(config_.preprocess),
+                                        deskew::DeskewTable::sample(motion, static_cast<float>(scan.duration_s())),
+                                        undistort, 1.0f / map_.spacing_m()};
   // one pass: each thread crops its block of the scan and deduplicates its cells
   const std::vector<std::int32_t>& kept = downsampler_.first_of_each_cell(
       scan.size(), executor_, [&](std::size_t first, std::size_t count, std::uint64_t* keys) {
-        downsampling_keys(scan.points.data() + first, count, pp, keys);
+        preprocess::downsampling_keys(scan.points.data() + first, count, pp, keys);
       });
   // then only the kept points are undistorted
   frame_.resize(kept.size());
   executor_.for_each(kept.size(), [&](std::size_t k) {
     const auto i = static_cast<std::size_t>(kept[k]);
-    frame_[k] = undistorted_point(scan.points[i], undistort ? scan.time_s[i] : 0.0f, pp);
+    frame_[k] = preprocess::undistorted_point(scan.points[i], undistort ? scan.time_s[i] : 0.0f, pp);
   });
   return frame_.size();
 }

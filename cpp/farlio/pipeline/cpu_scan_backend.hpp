@@ -6,8 +6,8 @@
 
 #include "farlio/exec/cpu_executor.hpp"
 #include "farlio/map/voxel_map.hpp"
-#include "farlio/pipeline/cell_downsampler.hpp"
 #include "farlio/pipeline/scan_backend.hpp"
+#include "farlio/preprocess/cell_downsampler.hpp"
 
 namespace farlio::pipeline {
 
@@ -34,7 +34,7 @@ class CpuScanBackend final : public ScanBackend {
   exec::CpuExecutor executor_;
   map::VoxelMap map_;
   map::VoxelMap frame_map_;
-  CellDownsampler downsampler_;
+  preprocess::CellDownsampler downsampler_;
   std::vector<Eigen::Vector3f> frame_;  // the kept points (sensor frame, scan end)
   registration::SourceCloud source_;
 };

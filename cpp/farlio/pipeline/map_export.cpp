@@ -11,7 +11,7 @@
 #include "farlio/map/voxel_key.hpp"
 #include "farlio/map/voxel_map.hpp"
 #include "farlio/map/voxel_update.hpp"
-#include "farlio/pipeline/preprocess_point.hpp"
+#include "farlio/preprocess/preprocess_point.hpp"
 
 namespace farlio::pipeline {
 namespace {
@@ -73,8 +73,9 @@ std::size_t MapExport::add(const Scan& scan, const deskew::ScanMotion& motion, b
   if (!spill_dir_.empty()) reload_near(sensor);
   const bool deskew = undistort && scan.has_time();
   // the cell size is not used here: only the crop and undistorted_point
-  const PreprocessParams pp{RangeCrop::from(preprocess_),
-                            deskew::DeskewTable::sample(motion, static_cast<float>(scan.duration_s())), deskew, 1.0f};
+  const preprocess::PreprocessParams pp{preprocess::RangeCrop::from(preprocess_),
+                                        deskew::DeskewTable::sample(motion, static_cast<float>(scan.duration_s())),
+                                        deskew, 1.0f};
   const Eigen::Matrix3d R = pose.rotation();
   const auto inv_cell = static_cast<float>(1.0 / resolution_m_);
   const bool has_intensity = scan.intensity.size() == scan.size();
@@ -85,7 +86,7 @@ std::size_t MapExport::add(const Scan& scan, const deskew::ScanMotion& motion, b
   executor_.for_each(n, [&](std::size_t i) {
     keys_[i] = map::kEmptyKey;
     if (!pp.crop.keeps(scan.points[i])) return;
-    const Eigen::Vector3f p = undistorted_point(scan.points[i], deskew ? scan.time_s[i] : 0.0f, pp);
+    const Eigen::Vector3f p = preprocess::undistorted_point(scan.points[i], deskew ? scan.time_s[i] : 0.0f, pp);
     const Eigen::Vector3d w = R * p.cast<double>() + sensor;
     const std::uint64_t key = map::point_key(w.cast<float>(), inv_cell);
     if (key == map::kEmptyKey) return;

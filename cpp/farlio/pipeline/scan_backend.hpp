@@ -3,7 +3,10 @@
 // the submap live and where the per-point bodies run (CPU executor or CUDA). ScanPipeline keeps
 // the logic between the stages (guesses, thresholds, density, velocity) on the host and calls
 // one backend method per stage.
+#include <algorithm>
 #include <cstddef>
+#include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -67,9 +70,24 @@ class ScanBackend {
   }
 };
 
+/// Voxels the CPU frame map preallocates (a scan fills ~1-2k; the pool doubles as needed).
+inline constexpr std::int64_t kFrameMapInitialVoxels = 1024;
+
 /// The frame map's parameters: the submap's spacing (the scan is downsampled to it) with the
-/// frame map's lower cap, no refresh, no removal.
-VoxelMapConfig frame_map_config(const Config& config);
+/// frame map's lower cap, no refresh, no removal. Inline: the CUDA backend (farlio_cuda, below
+/// the factory's library) uses it too.
+inline VoxelMapConfig frame_map_config(const Config& c) {
+  VoxelMapConfig f = c.map;
+  // the frame map keeps the submap's spacing (the scan is downsampled to it) with a lower cap
+  f.point_spacing_m = map::point_spacing_m(c.map);
+  f.max_points_per_voxel = c.density.frame_map_max_points_per_voxel;
+  f.refresh_covariances = false;
+  f.removal_radius_m = std::numeric_limits<double>::infinity();
+  // sized for one scan (~1-2k voxels, the pool doubles as needed), not for the submap: the
+  // per-frame clear and the voxel lookups touch a table of a few thousand slots, not 32k
+  f.initial_voxel_capacity = std::min<std::int64_t>(c.map.initial_voxel_capacity, kFrameMapInitialVoxels);
+  return f;
+}
 
 /// The backend for config.device (auto resolved by resolve_device; `message` explains a
 /// fallback to the CPU). Throws when cuda is asked for and cannot be had.

@@ -8,7 +8,7 @@
 #include "farlio/core/config_fields.hpp"
 #include "farlio/core/time.hpp"
 #include "farlio/map/adaptive_density.hpp"
-#include "farlio/pipeline/preprocess.hpp"
+#include "farlio/preprocess/preprocess.hpp"
 
 namespace farlio::pipeline {
 namespace {
@@ -149,7 +149,7 @@ FrameResult ScanPipeline::process(const Scan& input, const std::optional<SE3>& i
 void ScanPipeline::fix_scale(const Scan& scan) {
   if (scale_fixed_ || scan.empty()) return;
   scale_fixed_ = true;
-  const double voxel = scene_voxel_size_m(scan.points, config_.map);
+  const double voxel = preprocess::scene_voxel_size_m(scan.points, config_.map);
   if (voxel != config_.map.voxel_size_m) {
     config_.map.voxel_size_m = voxel;
     backend_->reset(config_);

@@ -16,6 +16,15 @@ from farlio.runner import DEVICES, format_summary, replay_options, run_dataset
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
+    _add_input_arguments(parser)
+    _add_recording_arguments(parser)
+    _add_latency_arguments(parser)
+    _add_map_arguments(parser)
+    _add_output_arguments(parser)
+
+
+def _add_input_arguments(parser: argparse.ArgumentParser) -> None:
+    """The recording, the output folder, the parameter set, the backend and which part of the recording runs."""
     parser.add_argument("path", type=Path, help=f"the recording, its format detected from the path: {FORMAT_HELP}")
     parser.add_argument("--out", type=Path, required=True, help="output folder (created)")
     parser.add_argument("--format", default="auto", choices=["auto", *FORMATS], help="input format")
@@ -47,6 +56,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="ground-truth body poses (TUM) to evaluate against; a sequence folder's "
         "groundtruth_scans.tum (MulRan: global_pose.csv; KITTI layout: groundtruth_kitti.txt) is used by default",
     )
+
+
+def _add_recording_arguments(parser: argparse.ArgumentParser) -> None:
+    """How a bag's or an Ouster recording's topics, calibration and point times are read."""
     rec = parser.add_argument_group("recordings (bags, Ouster, calibration)")
     rec.add_argument(
         "--lidar-topic",
@@ -99,6 +112,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "relative point times are <= 0, else start)",
     )
     rec.add_argument("--no-imu", action="store_true", help="ignore the recording's IMU: LiDAR-only odometry")
+
+
+def _add_latency_arguments(parser: argparse.ArgumentParser) -> None:
+    """When a scan's result reaches the fusion in the replay."""
     parser.add_argument(
         "--latency",
         default="measured",
@@ -116,6 +133,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="S",
         help="extra delay added to every result (latency sweeps)",
     )
+
+
+def _add_map_arguments(parser: argparse.ArgumentParser) -> None:
+    """The saved map, loop closure and localization in a prior map."""
     maps = parser.add_argument_group("maps")
     maps.add_argument(
         "--save-map",
@@ -159,6 +180,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="body pose at the first scan in the map's frame (metres, degrees; default: the origin, i.e. where "
         "the mapping run started); with an IMU roll and pitch come from gravity",
     )
+
+
+def _add_output_arguments(parser: argparse.ArgumentParser) -> None:
+    """Plots, progress and the live view."""
     parser.add_argument("--no-plot", action="store_true", help="do not write trajectory.png, latency.png and eval.png")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument(

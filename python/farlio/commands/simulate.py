@@ -11,6 +11,14 @@ from farlio.simulation import IMU_GRADES, LIDAR_MODELS, PROFILES, make_config, w
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
+    _add_sequence_arguments(parser)
+    _add_sensor_arguments(parser)
+    _add_noise_arguments(parser)
+    _add_output_arguments(parser)
+
+
+def _add_sequence_arguments(parser: argparse.ArgumentParser) -> None:
+    """The profile, where the sequence goes, its seed and which stretch of the motion it records."""
     parser.add_argument(
         "profile",
         choices=PROFILES,
@@ -37,6 +45,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="begin the sequence S seconds into the profile's motion (default 0: at its start, at rest); later "
         "starts record a body already moving, as a cut recording or a node restarted at speed does",
     )
+
+
+def _add_sensor_arguments(parser: argparse.ArgumentParser) -> None:
+    """The LiDAR model and the sensors' rates."""
     parser.add_argument(
         "--lidar",
         choices=LIDAR_MODELS,
@@ -60,6 +72,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="HZ",
         help="IMU samples per second (default: the profile's; 10 Hz is KITTI raw's OXTS rate)",
     )
+
+
+def _add_noise_arguments(parser: argparse.ArgumentParser) -> None:
+    """The sensors' errors: none, a datasheet IMU grade, or single noise levels."""
     parser.add_argument("--noise-free", action="store_true", help="exact ranges, no dropout, IMU without noise/bias")
     parser.add_argument(
         "--imu-grade",
@@ -81,6 +97,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--accel-noise", type=non_negative_float, default=None, metavar="M_S2", help="accel white noise std"
     )
+
+
+def _add_output_arguments(parser: argparse.ArgumentParser) -> None:
+    """The files written besides the sequence folder, and progress."""
     parser.add_argument(
         "--kitti",
         action="store_true",

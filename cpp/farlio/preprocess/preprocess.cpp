@@ -1,13 +1,13 @@
-#include "farlio/pipeline/preprocess.hpp"
+#include "farlio/preprocess/preprocess.hpp"
 
 #include <algorithm>
 #include <cmath>
 
 #include "farlio/map/voxel_update.hpp"
-#include "farlio/pipeline/cell_downsampler.hpp"
-#include "farlio/pipeline/range_crop.hpp"
+#include "farlio/preprocess/cell_downsampler.hpp"
+#include "farlio/preprocess/range_crop.hpp"
 
-namespace farlio::pipeline {
+namespace farlio::preprocess {
 
 std::vector<std::int32_t> crop_by_range(const std::vector<Eigen::Vector3f>& points, const PreprocessConfig& config) {
   const RangeCrop crop = RangeCrop::from(config);
@@ -50,4 +50,4 @@ double scene_voxel_size_m(const std::vector<Eigen::Vector3f>& points, const Voxe
                     config.voxel_size_m);
 }
 
-}  // namespace farlio::pipeline
+}  // namespace farlio::preprocess

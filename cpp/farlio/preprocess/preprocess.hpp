@@ -7,7 +7,7 @@
 #include "farlio/core/config.hpp"
 #include "farlio/exec/cpu_executor.hpp"
 
-namespace farlio::pipeline {
+namespace farlio::preprocess {
 
 /// Indices of the points whose range lies in [min_range_m, max_range_m] and that are finite.
 std::vector<std::int32_t> crop_by_range(const std::vector<Eigen::Vector3f>& points, const PreprocessConfig& config);
@@ -23,4 +23,4 @@ std::vector<std::int32_t> voxel_downsample(const std::vector<Eigen::Vector3f>& p
 /// is empty.
 double scene_voxel_size_m(const std::vector<Eigen::Vector3f>& points, const VoxelMapConfig& config);
 
-}  // namespace farlio::pipeline
+}  // namespace farlio::preprocess

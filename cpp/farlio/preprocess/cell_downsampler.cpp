@@ -1,4 +1,4 @@
-#include "farlio/pipeline/cell_downsampler.hpp"
+#include "farlio/preprocess/cell_downsampler.hpp"
 
 #include <algorithm>
 #include <array>
@@ -7,7 +7,7 @@
 
 #include "farlio/map/voxel_key.hpp"
 
-namespace farlio::pipeline {
+namespace farlio::preprocess {
 namespace {
 
 constexpr std::size_t kMinSlots = std::size_t{1} << 10;
@@ -132,4 +132,4 @@ const std::vector<std::int32_t>& CellDownsampler::merge_blocks(std::size_t block
   return kept_;
 }
 
-}  // namespace farlio::pipeline
+}  // namespace farlio::preprocess

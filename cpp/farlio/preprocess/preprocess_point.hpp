@@ -9,9 +9,9 @@
 #include "farlio/deskew/scan_motion.hpp"
 #include "farlio/exec/hd.hpp"
 #include "farlio/map/voxel_update.hpp"
-#include "farlio/pipeline/range_crop.hpp"
+#include "farlio/preprocess/range_crop.hpp"
 
-namespace farlio::pipeline {
+namespace farlio::preprocess {
 
 struct PreprocessParams {
   RangeCrop crop;
@@ -36,4 +36,4 @@ FARLIO_HD inline Eigen::Vector3f undistorted_point(const Eigen::Vector3f& raw, f
   return pp.undistort ? deskew::deskew_point(pp.motion, raw, tau_s) : raw;
 }
 
-}  // namespace farlio::pipeline
+}  // namespace farlio::preprocess

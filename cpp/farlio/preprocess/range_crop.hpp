@@ -7,7 +7,7 @@
 #include "farlio/exec/hd.hpp"
 #include "farlio/exec/hd_math.hpp"
 
-namespace farlio::pipeline {
+namespace farlio::preprocess {
 
 struct RangeCrop {
   float min_range2 = 0.0f;
@@ -22,4 +22,4 @@ struct RangeCrop {
   }
 };
 
-}  // namespace farlio::pipeline
+}  // namespace farlio::preprocess

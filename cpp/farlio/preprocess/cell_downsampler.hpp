@@ -16,7 +16,7 @@
 #include "farlio/exec/cpu_executor.hpp"
 #include "farlio/map/voxel_key.hpp"
 
-namespace farlio::pipeline {
+namespace farlio::preprocess {
 
 /// An open-addressing table cell key -> lowest index seen, owned by one thread at a time.
 class CellTable {
@@ -117,4 +117,4 @@ class CellDownsampler {
   std::size_t expected_cells_ = 0;  // cells of the previous call: sizes the tables
 };
 
-}  // namespace farlio::pipeline
+}  // namespace farlio::preprocess

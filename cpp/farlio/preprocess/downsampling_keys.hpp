@@ -8,11 +8,11 @@
 #include <cstdint>
 
 #include "farlio/core/types.hpp"
-#include "farlio/pipeline/preprocess_point.hpp"
+#include "farlio/preprocess/preprocess_point.hpp"
 
-namespace farlio::pipeline {
+namespace farlio::preprocess {
 
 /// keys[i] = downsampling_key(points[i], pp) for i in [0, n).
 void downsampling_keys(const Vec3f* points, std::size_t n, const PreprocessParams& pp, std::uint64_t* keys);
 
-}  // namespace farlio::pipeline
+}  // namespace farlio::preprocess

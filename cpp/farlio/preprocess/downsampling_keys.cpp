@@ -1,4 +1,4 @@
-#include "farlio/pipeline/downsampling_keys.hpp"
+#include "farlio/preprocess/downsampling_keys.hpp"
 
 #include <limits>
 
@@ -8,7 +8,7 @@
 
 #include "farlio/map/voxel_key.hpp"
 
-namespace farlio::pipeline {
+namespace farlio::preprocess {
 namespace {
 
 #if defined(__SSE2__)
@@ -70,4 +70,4 @@ void downsampling_keys(const Vec3f* points, std::size_t n, const PreprocessParam
   for (; i < n; ++i) keys[i] = downsampling_key(points[i], pp);
 }
 
-}  // namespace farlio::pipeline
+}  // namespace farlio::preprocess
