@@ -22,6 +22,7 @@ import argparse
 import json
 import os
 import random
+import shutil
 import signal
 import subprocess
 import sys
@@ -77,65 +78,155 @@ def stats(values_ms: list[float]) -> str:
     return f"{p[0]:7.2f} {p[1]:7.2f}"
 
 
-def main() -> int:
+def parse_args() -> argparse.Namespace:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--scans", type=int, default=100)
     ap.add_argument("--input-qos", default="reliable", choices=["reliable", "best_effort"])
     ap.add_argument("--transport", default="large-data", choices=["large-data", "ros-default"])
     ap.add_argument("--param", action="append", default=[], metavar="NAME:=VALUE", help="a node parameter (repeatable)")
     ap.add_argument("--json", type=Path, default=None)
-    args = ap.parse_args()
+    return ap.parse_args()
 
+
+def start_node(args: argparse.Namespace, seq: Path, log_path: Path) -> subprocess.Popen:
+    """`farlio ros2` in its own process, with the sequence's calibration and the given parameters."""
+    cmd = [sys.executable, "-m", "farlio.cli", "ros2", "--transport", args.transport, "--ros-args"]
+    cmd += ["-p", f"calib_file:={seq / 'calib.yaml'}", "-p", f"input_qos:={args.input_qos}"]
+    cmd += [a for p in args.param for a in ("-p", p)]
+    log = open(log_path, "w")  # noqa: SIM115
+    return subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT)
+
+
+def subscribe(node, got: dict[str, list[tuple[int, object]]]) -> list:
+    """Subscriptions to the node's odometry, scan odometry and diagnostics, stamped on arrival."""
+    from diagnostic_msgs.msg import DiagnosticArray
+    from nav_msgs.msg import Odometry
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
+
+    qos = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
+    return [
+        node.create_subscription(kind, f"/farlio/{key}", lambda m, k=key: got[k].append((time.monotonic_ns(), m)), qos)
+        for key, kind in (("odometry", Odometry), ("scan_odometry", Odometry), ("diagnostics", DiagnosticArray))
+    ]
+
+
+def wait_for_publishers(subs: list, node_proc: subprocess.Popen) -> bool:
+    deadline = time.monotonic() + START_TIMEOUT_S
+    while not all(s.get_publisher_count() for s in subs):
+        if time.monotonic() > deadline or node_proc.poll() is not None:
+            return False
+        time.sleep(0.05)
+    return True
+
+
+def latencies(got: dict[str, list[tuple[int, object]]], sent_ns: dict[int, int]) -> dict[str, list[float]]:
+    """Per processed scan (ms): the node's latency, the pipeline's, their difference, and end to end
+    from publishing the cloud to the scan odometry and to the next fused odometry."""
+    from farlio.ros2.conversions import stamp_ns
+
+    diags = [{kv.key: kv.value for kv in m.status[0].values} for _, m in got["diagnostics"]]
+    processed = [d for d in diags[1:] if d["processed"] == "True"]  # the first scan starts the map
+    node_ms = [float(d["latency_ms"]) for d in processed]
+    pipe_ms = [float(d["pipeline_ms"]) for d in processed]
+    scan_rx = {stamp_ns(m.header.stamp): t for t, m in got["scan_odometry"]}
+    odo_rx = np.array([t for t, _ in got["odometry"]])
+    e2e_scan, e2e_fused = [], []
+    for stamp, sent in sent_ns.items():
+        if stamp in scan_rx:
+            e2e_scan.append((scan_rx[stamp] - sent) * MS)
+            after = odo_rx[odo_rx > scan_rx[stamp]]
+            if after.size:
+                e2e_fused.append((after[0] - sent) * MS)
+    over_ms = [a - b for a, b in zip(node_ms, pipe_ms)]
+    return {"node": node_ms, "pipeline": pipe_ms, "overhead": over_ms, "e2e_scan": e2e_scan, "e2e_fused": e2e_fused}
+
+
+def summarise(got, played, lat: dict[str, list[float]], args, transport: str, cpu: float, base_cpu: float) -> dict:
+    diags = [{kv.key: kv.value for kv in m.status[0].values} for _, m in got["diagnostics"]]
+    processed = [d for d in diags[1:] if d["processed"] == "True"]
+    received = int(diags[-1]["clouds"]) if diags else 0
+    wall_s = played.wall_s + SETTLE_S
+    return {
+        "scans_published": played.scans,
+        "clouds_received": received,
+        "clouds_lost": played.clouds - received,
+        "scans_dropped_busy": int(diags[-1]["scans_dropped_busy"]) if diags else None,
+        "points_per_scan": float(np.mean([int(d["input_points"]) for d in processed])) if processed else 0,
+        "input_qos": args.input_qos,
+        "transport": transport,
+        "wall_s": wall_s,
+        "node_cpu_core_share": cpu / wall_s,
+        "pipeline_cpu_core_share": base_cpu / wall_s,
+        "latency_ms": {
+            k: dict(zip(("median", "p99"), np.percentile(v, PERCENTILES).tolist())) if v else None
+            for k, v in lat.items()
+        },
+    }
+
+
+def print_report(result: dict, played, lat: dict[str, list[float]]) -> None:
+    received = result["clouds_received"]
+    print(f"transport: {result['transport']}; input QoS {result['input_qos']}")
+    print(
+        f"clouds: {played.clouds} published, {received} received by the node ({played.clouds - received} lost), "
+        f"{result['scans_dropped_busy']} dropped while the pipeline was busy; "
+        f"{result['points_per_scan']:.0f} points a scan"
+    )
+    print("latency (ms)        median     p99")
+    for name, key in (
+        ("node (arrival->scan odometry)", "node"),
+        ("pipeline frame", "pipeline"),
+        ("node overhead", "overhead"),
+        ("e2e cloud->scan odometry", "e2e_scan"),
+        ("e2e cloud->fused odometry", "e2e_fused"),
+    ):
+        print(f"  {name:30s} {stats(lat[key])}")
+    print(
+        f"CPU (share of one core over {result['wall_s']:.1f} s): node {result['node_cpu_core_share']:.2f}, "
+        f"OnlineOdometry alone on the same data {result['pipeline_cpu_core_share']:.2f}"
+    )
+
+
+def main() -> int:
+    args = parse_args()
+    tmp = Path(tempfile.mkdtemp(prefix="farlio_bench_ros2_"))
+    try:
+        return measure(args, tmp)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def measure(args: argparse.Namespace, tmp: Path) -> int:
+    """Generates the sequence into `tmp`, starts the node, plays the scans to it and reports."""
     os.environ.setdefault("ROS_DOMAIN_ID", str(random.randint(1, 100)))
     os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
     from farlio.ros2 import choose_transport
 
     transport = choose_transport(args.transport)  # this process and (inherited) the node
     import rclpy
-    from diagnostic_msgs.msg import DiagnosticArray
+    from farlio.config import load_config
     from farlio.datasets import open_dataset
-    from farlio.ros2.conversions import stamp_ns
     from farlio.ros2.play import Player, PlayOptions
     from farlio.simulation import generate
-    from nav_msgs.msg import Odometry
     from rclpy.executors import SingleThreadedExecutor
-    from rclpy.qos import QoSProfile, ReliabilityPolicy
 
-    tmp = Path(tempfile.mkdtemp(prefix="farlio_bench_ros2_"))
     seq = tmp / "urban"
     generate("urban", seq, duration_s=args.scans / 10 + 0.5)
     ds = open_dataset(seq)
-    from farlio.config import load_config
-
     config_overrides = [p.replace(":=", "=", 1) for p in args.param if p.split(":=")[0] in farlio_fields()]
     base_cpu = pipeline_cpu_s(ds, args.scans, load_config(None, config_overrides))
-
-    cmd = [sys.executable, "-m", "farlio.cli", "ros2", "--transport", args.transport, "--ros-args"]
-    cmd += ["-p", f"calib_file:={seq / 'calib.yaml'}", "-p", f"input_qos:={args.input_qos}"]
-    cmd += [a for p in args.param for a in ("-p", p)]
-    log = open(tmp / "node.log", "w")  # noqa: SIM115
-    node_proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT)
+    node_proc = start_node(args, seq, tmp / "node.log")
 
     rclpy.init()
     node = rclpy.create_node("farlio_bench")
     got: dict[str, list[tuple[int, object]]] = {"odometry": [], "scan_odometry": [], "diagnostics": []}
-    qos = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
-    subs = []
-    for key, kind in (("odometry", Odometry), ("scan_odometry", Odometry), ("diagnostics", DiagnosticArray)):
-        subs.append(
-            node.create_subscription(
-                kind, f"/farlio/{key}", lambda m, k=key: got[k].append((time.monotonic_ns(), m)), qos
-            )
-        )
+    subs = subscribe(node, got)
     executor = SingleThreadedExecutor()
     executor.add_node(node)
     threading.Thread(target=executor.spin, daemon=True).start()
-    deadline = time.monotonic() + START_TIMEOUT_S
-    while not all(s.get_publisher_count() for s in subs):
-        if time.monotonic() > deadline or node_proc.poll() is not None:
-            print(Path(tmp / "node.log").read_text())
-            return 1
-        time.sleep(0.05)
+    if not wait_for_publishers(subs, node_proc):
+        print((tmp / "node.log").read_text())
+        return 1
 
     player = Player(node, ds, PlayOptions(max_scans=args.scans, wait_subscribers_s=START_TIMEOUT_S))
     player.wait_for_subscribers()
@@ -147,62 +238,9 @@ def main() -> int:
     node_proc.wait(30)
     executor.shutdown()
 
-    diags = [{kv.key: kv.value for kv in m.status[0].values} for _, m in got["diagnostics"]]
-    received = int(diags[-1]["clouds"]) if diags else 0
-    processed = [d for d in diags[1:] if d["processed"] == "True"]  # the first scan starts the map
-    node_ms = [float(d["latency_ms"]) for d in processed]
-    pipe_ms = [float(d["pipeline_ms"]) for d in processed]
-    over_ms = [a - b for a, b in zip(node_ms, pipe_ms)]
-    scan_rx = {stamp_ns(m.header.stamp): t for t, m in got["scan_odometry"]}
-    odo_rx = np.array([t for t, _ in got["odometry"]])
-    e2e_scan, e2e_fused = [], []
-    for stamp, sent in played.sent_ns.items():
-        if stamp in scan_rx:
-            e2e_scan.append((scan_rx[stamp] - sent) * MS)
-            after = odo_rx[odo_rx > scan_rx[stamp]]
-            if after.size:
-                e2e_fused.append((after[0] - sent) * MS)
-    wall_s = played.wall_s + SETTLE_S
-    result = {
-        "scans_published": played.scans,
-        "clouds_received": received,
-        "clouds_lost": played.clouds - received,
-        "scans_dropped_busy": int(diags[-1]["scans_dropped_busy"]) if diags else None,
-        "points_per_scan": float(np.mean([int(d["input_points"]) for d in processed])) if processed else 0,
-        "input_qos": args.input_qos,
-        "transport": transport,
-        "node_cpu_core_share": (cpu1 - cpu0) / wall_s,
-        "pipeline_cpu_core_share": base_cpu / wall_s,
-        "latency_ms": {
-            k: dict(zip(("median", "p99"), np.percentile(v, PERCENTILES).tolist())) if v else None
-            for k, v in (
-                ("node", node_ms),
-                ("pipeline", pipe_ms),
-                ("overhead", over_ms),
-                ("e2e_scan", e2e_scan),
-                ("e2e_fused", e2e_fused),
-            )
-        },
-    }
-    print(f"transport: {transport}; input QoS {args.input_qos}")
-    print(
-        f"clouds: {played.clouds} published, {received} received by the node ({played.clouds - received} lost), "
-        f"{result['scans_dropped_busy']} dropped while the pipeline was busy; "
-        f"{result['points_per_scan']:.0f} points a scan"
-    )
-    print("latency (ms)        median     p99")
-    for name, values in (
-        ("node (arrival->scan odometry)", node_ms),
-        ("pipeline frame", pipe_ms),
-        ("node overhead", over_ms),
-        ("e2e cloud->scan odometry", e2e_scan),
-        ("e2e cloud->fused odometry", e2e_fused),
-    ):
-        print(f"  {name:30s} {stats(values)}")
-    print(
-        f"CPU (share of one core over {wall_s:.1f} s): node {result['node_cpu_core_share']:.2f}, "
-        f"OnlineOdometry alone on the same data {result['pipeline_cpu_core_share']:.2f}"
-    )
+    lat = latencies(got, played.sent_ns)
+    result = summarise(got, played, lat, args, transport, cpu1 - cpu0, base_cpu)
+    print_report(result, played, lat)
     if args.json:
         args.json.write_text(json.dumps(result, indent=2))
     node.destroy_node()

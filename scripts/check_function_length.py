@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """No function over MAX_LINES lines outside the tests: the C++/CUDA sources (cpp/, bindings/, bench/,
-fuzz/) and the Python (python/, scripts/). Prints each longer function as `path:line: name is N
+fuzz/) and the Python (python/, scripts/, figures/). Prints each longer function as `path:line: name is N
 lines` and exits 1 when one is found that the allow-list does not name. Part of
 scripts/check_format.sh (CI).
 
@@ -34,7 +34,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 MAX_LINES = 80
 CPP_ROOTS = ("cpp", "bindings", "bench", "fuzz")
-PY_ROOTS = ("python", "scripts")
+PY_ROOTS = ("python", "scripts", "figures")
 CPP_SUFFIXES = (".cpp", ".hpp", ".cu", ".cuh", ".h", ".cc")
 SCOPE_KEYWORDS = ("namespace", "class", "struct", "union", "extern")
 _NAME = re.compile(r"((?:[A-Za-z_~][A-Za-z_0-9]*\s*(?:<[^()]*>)?\s*::\s*)*~?[A-Za-z_][A-Za-z_0-9]*)\s*$")

@@ -285,20 +285,67 @@ ScanPrior FusionDriver::prior(const Scan& scan, const registration::Vec6d& lidar
   return prior;
 }
 
+std::optional<Mat6d> FusionDriver::registration_covariance(OdometryFrame& frame) const {
+  if (!frame.scan.registered || frame.scan.registration.system.inliers <= 0) return std::nullopt;
+  Mat6d covariance = registration::covariance_from_information(registration::body_information(
+      frame.scan.registration.system.H, T_imu_lidar_, registration_config_.covariance_scale));
+  frame.degeneracy = registration::analyze_degeneracy(
+      covariance, static_cast<double>(frame.scan.registration.system.inliers), registration_config_);
+  // the registration held these at the fusion's prior: the scan says nothing there
+  if (registration_config_.hold_degenerate_directions && frame.guess_from_fusion) {
+    covariance = registration::release_degenerate_directions(covariance, *frame.degeneracy);
+  }
+  return covariance;
+}
+
+void FusionDriver::compare_gyro_unit(std::int64_t stamp_ns, const OdometryFrame& frame) {
+  // the gyro's unit is judged against scans that constrain every direction: the rotations of a
+  // degenerate scan (a narrow field of view sliding along the track) carry errors that add up to a
+  // turn the gyro did not make
+  const bool constrained = !frame.degeneracy || !frame.degeneracy->degenerate();
+  if (!frame.drop_reason.empty() || !fusion_ || !has_imu() || gyro_unit_.decided() || !last_body_ ||
+      stamp_ns <= last_body_->stamp_ns || !constrained)
+    return;
+  const Eigen::Vector3d lidar_rotation = so3_log((last_body_->pose.inverse() * frame.body_pose).rotation());
+  const auto gyro_rotation = fusion_->imu_rotation(last_body_->stamp_ns, stamp_ns);
+  gyro_follows_lidar_ =
+      gyro_rotation &&
+      so3_log(*gyro_rotation).norm() <= kRotationAgreementRatio * lidar_rotation.norm() + kRotationAgreementFloor_rad;
+  gyro_unit_.add_lidar_rotation(last_body_->stamp_ns, stamp_ns, lidar_rotation);
+  if (gyro_unit_.decided()) apply_gyro_unit();
+  if (!first_compared_ns_) first_compared_ns_ = stamp_ns;
+  if (!gyro_unit_.decided() && !warned_undecided_gyro_ &&
+      ns_to_seconds(stamp_ns - *first_compared_ns_) > kUndecidedGyroWarning_s) {
+    warn("the gyro's unit (rad/s or deg/s) is not decided after " + seconds_text(kUndecidedGyroWarning_s) +
+         " s of scans: the LiDAR has hardly turned. Until it turns, a gyro in deg/s would turn the fused "
+         "orientation 57 times too far (fusion.gyro_unit_detection)");
+    warned_undecided_gyro_ = true;
+  }
+}
+
+void FusionDriver::hold_start_at_degenerate_scan(std::int64_t stamp_ns, OdometryFrame& frame) {
+  if (!frame.drop_reason.empty() || !fusion_ || !has_imu() || fusion_->initialized() || !frame.degeneracy ||
+      frame.degeneracy->degenerate_translations == 0)
+    return;
+  // a pose that stands still along a direction the scan does not constrain says nothing of the
+  // velocity there (a sparse LiDAR at speed between parallel walls registers as standing): the
+  // filter starts from a run of scans that constrain every direction
+  fusion_->restart_window();
+  frame.drop_reason = "not fused: the filter is not initialised from a scan with a degenerate direction";
+  if (!first_degenerate_start_ns_) first_degenerate_start_ns_ = stamp_ns;
+  if (!warned_degenerate_start_ && ns_to_seconds(stamp_ns - *first_degenerate_start_ns_) > kDegenerateStartWarning_s) {
+    warn("the filter has not started after " + seconds_text(kDegenerateStartWarning_s) +
+         " s of scans that do not constrain every direction (degenerate: a narrow field of view, a corridor, "
+         "a sparse LiDAR at speed): the odometry is LiDAR-only, without the 100 Hz output, until the scans "
+         "constrain every direction");
+    warned_degenerate_start_ = true;
+  }
+}
+
 void FusionDriver::link(const Scan& scan, OdometryFrame& frame) {
   frame.drop_reason = drop_reason(frame.scan, last_body_.has_value());
   if (fusion_ && (frame.scan.map_restarted || frame.scan.map_started_here)) fusion_->restart_window();
-  std::optional<Mat6d> covariance;
-  if (frame.scan.registered && frame.scan.registration.system.inliers > 0) {
-    covariance = registration::covariance_from_information(registration::body_information(
-        frame.scan.registration.system.H, T_imu_lidar_, registration_config_.covariance_scale));
-    frame.degeneracy = registration::analyze_degeneracy(
-        *covariance, static_cast<double>(frame.scan.registration.system.inliers), registration_config_);
-    // the registration held these at the fusion's prior: the scan says nothing there
-    if (registration_config_.hold_degenerate_directions && frame.guess_from_fusion) {
-      covariance = registration::release_degenerate_directions(*covariance, *frame.degeneracy);
-    }
-  }
+  const std::optional<Mat6d> covariance = registration_covariance(frame);
   const std::int64_t stamp_ns = scan.end_stamp_ns;
   if (frame.drop_reason.empty() && fusion_ && !has_imu()) {
     frame.drop_reason = "not fused: no IMU sample yet (LiDAR-only until the first one arrives)";
@@ -308,51 +355,14 @@ void FusionDriver::link(const Scan& scan, OdometryFrame& frame) {
       warned_no_imu_ = true;
     }
   }
-  // the gyro's unit is judged against scans that constrain every direction: the rotations of a
-  // degenerate scan (a narrow field of view sliding along the track) carry errors that add up to a
-  // turn the gyro did not make
-  const bool constrained = !frame.degeneracy || !frame.degeneracy->degenerate();
-  if (frame.drop_reason.empty() && fusion_ && has_imu() && !gyro_unit_.decided() && last_body_ &&
-      stamp_ns > last_body_->stamp_ns && constrained) {
-    const Eigen::Vector3d lidar_rotation = so3_log((last_body_->pose.inverse() * frame.body_pose).rotation());
-    const auto gyro_rotation = fusion_->imu_rotation(last_body_->stamp_ns, stamp_ns);
-    gyro_follows_lidar_ =
-        gyro_rotation &&
-        so3_log(*gyro_rotation).norm() <= kRotationAgreementRatio * lidar_rotation.norm() + kRotationAgreementFloor_rad;
-    gyro_unit_.add_lidar_rotation(last_body_->stamp_ns, stamp_ns, lidar_rotation);
-    if (gyro_unit_.decided()) apply_gyro_unit();
-    if (!first_compared_ns_) first_compared_ns_ = stamp_ns;
-    if (!gyro_unit_.decided() && !warned_undecided_gyro_ &&
-        ns_to_seconds(stamp_ns - *first_compared_ns_) > kUndecidedGyroWarning_s) {
-      warn("the gyro's unit (rad/s or deg/s) is not decided after " + seconds_text(kUndecidedGyroWarning_s) +
-           " s of scans: the LiDAR has hardly turned. Until it turns, a gyro in deg/s would turn the fused "
-           "orientation 57 times too far (fusion.gyro_unit_detection)");
-      warned_undecided_gyro_ = true;
-    }
-  }
+  compare_gyro_unit(stamp_ns, frame);
   if (frame.drop_reason.empty() && fusion_ && has_imu() && !fusion_->initialized() &&
       ns_to_seconds(clock_ns_) - ns_to_seconds(stamp_ns) > fusion_config_.max_bridged_gap_s) {
     frame.drop_reason =
         "not fused: the scan ends " + seconds_text(ns_to_seconds(clock_ns_) - ns_to_seconds(stamp_ns)) +
         " s before the IMU clock, beyond fusion.max_bridged_gap_s (do the IMU and LiDAR clocks differ?)";
   }
-  if (frame.drop_reason.empty() && fusion_ && has_imu() && !fusion_->initialized() && frame.degeneracy &&
-      frame.degeneracy->degenerate_translations > 0) {
-    // a pose that stands still along a direction the scan does not constrain says nothing of the
-    // velocity there (a sparse LiDAR at speed between parallel walls registers as standing): the
-    // filter starts from a run of scans that constrain every direction
-    fusion_->restart_window();
-    frame.drop_reason = "not fused: the filter is not initialised from a scan with a degenerate direction";
-    if (!first_degenerate_start_ns_) first_degenerate_start_ns_ = stamp_ns;
-    if (!warned_degenerate_start_ &&
-        ns_to_seconds(stamp_ns - *first_degenerate_start_ns_) > kDegenerateStartWarning_s) {
-      warn("the filter has not started after " + seconds_text(kDegenerateStartWarning_s) +
-           " s of scans that do not constrain every direction (degenerate: a narrow field of view, a corridor, "
-           "a sparse LiDAR at speed): the odometry is LiDAR-only, without the 100 Hz output, until the scans "
-           "constrain every direction");
-      warned_degenerate_start_ = true;
-    }
-  }
+  hold_start_at_degenerate_scan(stamp_ns, frame);
   if (frame.drop_reason.empty() && fusion_ && has_imu()) {
     Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
     std::optional<Eigen::Matrix3d> velocity_covariance;

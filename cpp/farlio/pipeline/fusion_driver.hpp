@@ -139,6 +139,15 @@ class FusionDriver {
   void jump_clock(const ImuSample& sample);
   /// After the gyro unit was decided: scales and restarts, or ends the fusion.
   void apply_gyro_unit();
+  /// The registration's pose covariance in the body frame (its degenerate directions released when
+  /// the registration held them); sets frame.degeneracy. nullopt without a registered scan.
+  [[nodiscard]] std::optional<Mat6d> registration_covariance(OdometryFrame& frame) const;
+  /// While the gyro's unit is undecided: compares the gyro's rotation with the LiDAR's over the
+  /// last scan interval (scans with a degenerate direction left out) and applies a decision.
+  void compare_gyro_unit(std::int64_t stamp_ns, const OdometryFrame& frame);
+  /// Before the filter: a scan with a degenerate translation restarts the initialisation window and
+  /// is not fused (with a warning once such scans have held the start for a while).
+  void hold_start_at_degenerate_scan(std::int64_t stamp_ns, OdometryFrame& frame);
   /// The sample with its gyro in rad/s.
   [[nodiscard]] ImuSample in_si_units(const ImuSample& sample) const;
   void warn(std::string message);
