@@ -17,14 +17,14 @@ from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
-import farlio
 from farlio import _core
 from farlio.config import load_config
 from farlio.datasets import open_dataset
 from farlio.datasets.base import Dataset
+from farlio.datasets.generated import GeneratedDataset
 from farlio.mapping import MapOptions
 from farlio.runner import replay_options, run_dataset
-from farlio.simulation import generate, make_config
+from farlio.simulation import generate
 from farlio.timing_csv import TIMING_CSV
 
 #: the replay latency of every accuracy figure in the docs (s)
@@ -58,35 +58,10 @@ def generated_sequence(work: Path, profile: str, seed: int = 1, duration_s: floa
     return folder
 
 
-class GeneratedDataset(Dataset):
-    """A generated sequence served from memory, scan by scan (no scans on disk: a racetrack lap is
-    ~7 GB of PCD), with its ground truth written to `work` as a TUM file for the evaluation."""
-
-    def __init__(self, profile: str, seed: int, duration_s: float, work: Path, **sim: Any):
-        """sim: further make_config arguments (lidar, lidar_rate_hz, ...)."""
-        self.gen = _core.sim.SequenceGenerator(make_config(profile, seed=seed, duration_s=duration_s, **sim))
-        self.path = work / f"{profile}-{seed}"
-        self.path.mkdir(parents=True, exist_ok=True)
-        self.gt_scans = self.path / "groundtruth_scans.tum"
-        _core.io.write_tum(self.gt_scans, self.gen.groundtruth_scans())
-
-    def __len__(self) -> int:
-        return self.gen.num_scans()
-
-    def scan(self, i: int) -> farlio.Scan:
-        return self.gen.scan(i)
-
-    def imu(self) -> list:
-        return self.gen.imu()
-
-    def T_imu_lidar(self) -> farlio.SE3:
-        return self.gen.T_imu_lidar()
-
-    def gravity_m_s2(self) -> float:
-        return self.gen.gravity_m_s2()
-
-    def groundtruth_scans_file(self) -> Path:
-        return self.gt_scans
+def generated_dataset(profile: str, seed: int, duration_s: float, work: Path, **sim: Any) -> GeneratedDataset:
+    """A generated sequence served from memory (no scans on disk: a racetrack lap is ~7 GB of PCD),
+    its ground truth in `work`/PROFILE-SEED. sim: further make_config arguments (lidar, ...)."""
+    return GeneratedDataset(profile, seed, duration_s, work / f"{profile}-{seed}", **sim)
 
 
 def recording_scans(path: str | Path) -> list:

@@ -32,7 +32,7 @@ import numpy as np
 from farlio import _core
 from farlio.mapping import MAP_PCD, MapOptions
 from farlio.runner import SCANS_BODY_TUM
-from harness import GeneratedDataset, ape_m, config, floats, run, timing_rows, work_folder
+from harness import ape_m, config, floats, generated_dataset, run, timing_rows, work_folder
 
 #: (map duration, pass duration) in seconds
 DURATIONS_S = {"urban": (60.0, 60.0), "handheld": (60.0, 60.0), "racetrack": (85.0, 165.0), "tunnel": (45.0, 45.0)}
@@ -64,7 +64,7 @@ def frame_stats(out: Path) -> tuple[float, float, float]:
 def measure(profile: str, pass_seeds: list[int], out: Path, work: Path) -> dict:
     map_s, pass_s = DURATIONS_S[profile]
     mapping = run(
-        GeneratedDataset(profile, MAP_SEED, map_s, work), work / f"{profile}-map", config(), MapOptions(save=True)
+        generated_dataset(profile, MAP_SEED, map_s, work), work / f"{profile}-map", config(), MapOptions(save=True)
     )
     mapping_poses = poses(work / f"{profile}-map" / SCANS_BODY_TUM)
     result = {"map": mapping["map"], "mapping_ape_m": ape_m(mapping["accuracy"]), "passes": {}}
@@ -75,7 +75,7 @@ def measure(profile: str, pass_seeds: list[int], out: Path, work: Path) -> dict:
             ("odometry", MapOptions()),
             ("localization", MapOptions(prior_map=work / f"{profile}-map" / MAP_PCD)),
         ):
-            data = GeneratedDataset(profile, seed, pass_s, work)
+            data = generated_dataset(profile, seed, pass_s, work)
             o = work / f"{profile}-{seed}-{mode}"
             s = run(data, o, config(), maps)
             est, gt = poses(o / SCANS_BODY_TUM), poses(data.gt_scans)

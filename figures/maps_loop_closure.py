@@ -35,7 +35,7 @@ import numpy as np
 from farlio import _core
 from farlio.loop_closure import LOOPS_CSV, MIN_LOOP_TRAVEL_FACTOR, LoopClosure
 from farlio.mapping import MapOptions
-from harness import GeneratedDataset, ape_m, config, fixed_latency, run, table_row
+from harness import GeneratedDataset, ape_m, config, fixed_latency, generated_dataset, run, table_row
 from scipy.spatial.transform import Rotation  # xyzw quaternions, as loops.csv
 
 CORRECT_LOOP_M, CORRECT_LOOP_DEG = 0.5, 1.0
@@ -143,7 +143,7 @@ def main() -> None:
     if args.handover:
         for seed in args.seeds:
             handover(
-                GeneratedDataset(
+                generated_dataset(
                     args.profile, seed, args.duration, out, lidar=args.lidar, lidar_rate_hz=args.lidar_rate
                 ),
                 cfg,
@@ -151,7 +151,7 @@ def main() -> None:
         return
     print(table_row(*COLUMNS))
     for seed in args.seeds:
-        ds = GeneratedDataset(args.profile, seed, args.duration, out, lidar=args.lidar, lidar_rate_hz=args.lidar_rate)
+        ds = generated_dataset(args.profile, seed, args.duration, out, lidar=args.lidar, lidar_rate_hz=args.lidar_rate)
         s = run(ds, out / f"run-{seed}", cfg, MapOptions(loop_closure=True))
         lc = s["loop_closure"]
         precision, recall = precision_recall(ds.gen, out / f"run-{seed}" / LOOPS_CSV, cfg.get("loop.submap_length_m"))

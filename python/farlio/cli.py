@@ -16,6 +16,10 @@ import warnings
 COMMANDS = {
     "run": ("farlio.commands.run", "run the odometry over a recording and write trajectories, timings, summary"),
     "simulate": ("farlio.commands.simulate", "generate a LiDAR + IMU sequence with exact ground truth"),
+    "demo": (
+        "farlio.commands.demo",
+        "the LIO on a generated sequence served from memory (no scans on disk), its map and its accuracy",
+    ),
     "eval": ("farlio.commands.evaluate", "compare a trajectory with ground truth (APE, RPE, coverage)"),
     "ablate": ("farlio.commands.ablate", "component ablation (EKF, DC, MU, SA GICP, ASMD) on a recording"),
     "latency-sweep": ("farlio.commands.latency_sweep", "APE as the pipeline latency grows (added delays)"),

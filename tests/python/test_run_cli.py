@@ -51,3 +51,22 @@ def test_unknown_layout_lists_the_formats(tmp_path, capsys):
     assert main(["run", str(tmp_path / "empty"), "--out", str(tmp_path / "out")]) == 2
     err = capsys.readouterr().err
     assert "cannot tell its format" in err and "ROS 1 .bag" in err and "Ouster .pcap" in err
+
+
+def test_demo_runs_on_a_generated_sequence_without_writing_its_scans(tmp_path):
+    """`farlio demo`: the LIO on 8 s of the urban drive served from memory. It writes `farlio run
+    --save-map`'s files and the ground truth, tracks the exact ground truth to centimetres, and puts
+    no scan on disk (the same 8 s as `farlio simulate` writes are about 190 MB)."""
+    import json
+
+    out = tmp_path / "demo"
+    assert main(["demo", "--out", str(out), "--duration", "8", "--no-plot", "--no-progress"]) == 0
+    for name in ("scans_body.tum", "odometry_body.tum", "map.pcd", "summary.json", "groundtruth/groundtruth.tum"):
+        assert (out / name).is_file(), name
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["processed"] == summary["frames"] == 80
+    assert summary["fusion"]["initialization"]["mode"] == "standstill"
+    assert summary["accuracy"]["ape"]["translation_m"]["rmse"] < 0.03
+    assert summary["accuracy_odometry"]["ape"]["translation_m"]["rmse"] < 0.03
+    size = sum(f.stat().st_size for f in out.rglob("*") if f.is_file())
+    assert size < 20e6, f"{size / 1e6:.1f} MB"
