@@ -32,7 +32,10 @@ COMMANDS = {
         "farlio.commands.ros2_play",
         "publish a recording as ROS 2 topics, in real time or faster (.venv-ros)",
     ),
-    "config": ("farlio.commands.config", "print every parameter with its default and meaning (YAML)"),
+    "config": (
+        "farlio.commands.config",
+        "print the essential parameters (--all: every one) with their defaults and meaning (YAML)",
+    ),
     "info": ("farlio.commands.info", "print the build (CUDA backend, devices) and version"),
 }
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 import pytest
+import yaml
 from farlio import _core
 from farlio.config import config_to_yaml, load_config
 
@@ -89,3 +90,22 @@ def test_fields_list_defaults_docs_and_ranges():
     by_name = {f[0]: f for f in fields}
     assert by_name["fusion.step_s"][1:] == (0.01, by_name["fusion.step_s"][2], "in [1e-04, 1]")
     assert all(doc for _, _, doc, _ in fields)
+
+
+@pytest.mark.parametrize("everything", [False, True])
+def test_farlio_config_prints_the_essential_fields_or_all_and_reads_back(tmp_path, everything):
+    """`farlio config` writes the essential fields (each a real field, each once), `--all` every field;
+    either file loads back to the defaults, the essential one because a field left out keeps its
+    default."""
+    from farlio.cli import main
+    from farlio.commands.config import ESSENTIAL_FIELDS
+
+    names = [f[0] for f in _core.Config.fields()]
+    assert set(ESSENTIAL_FIELDS) <= set(names) and len(set(ESSENTIAL_FIELDS)) == len(ESSENTIAL_FIELDS)
+    out = tmp_path / "config.yaml"
+    assert main(["config", "--out", str(out), *(["--all"] if everything else [])]) == 0
+    written = set()
+    for key, value in yaml.safe_load(out.read_text()).items():
+        written |= {f"{key}.{leaf}" for leaf in value} if isinstance(value, dict) else {key}
+    assert written == (set(names) if everything else set(ESSENTIAL_FIELDS))
+    assert load_config(out) == _core.Config()

@@ -1,4 +1,6 @@
-"""`farlio config`: every parameter with its default and meaning, as a YAML file to edit."""
+"""`farlio config`: the parameters with their defaults and meaning, as a YAML file to edit: the
+essential ones (what a user sets for a sensor, a platform or a computer) by default, every one with
+`--all`. Every field keeps its default in any file that leaves it out."""
 
 from __future__ import annotations
 
@@ -10,8 +12,32 @@ import yaml
 from farlio import _core
 
 
+#: the fields a user sets for a sensor, a platform or a computer; the others are the method's own
+#: (docs/odometry.md, docs/fusion.md) and serve every sensor and dataset at their defaults
+ESSENTIAL_FIELDS = (
+    "device",
+    "num_threads",
+    "preprocess.min_range_m",
+    "preprocess.max_range_m",
+    "map.voxel_size_m",
+    "map.max_points_per_voxel",
+    "registration.time_budget_factor",
+    "fusion.enabled",
+    "fusion.gyro_input_std_rad_s",
+    "fusion.accel_input_std_m_s2",
+    "localization.min_inlier_fraction",
+    "loop.keyframe_distance_m",
+    "loop.search_radius_m",
+)
+
+
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", type=Path, default=None, help="write the YAML here instead of printing it")
+    parser.add_argument(
+        "--all",
+        action="store_true",
+        help=f"every parameter ({len(_core.Config.fields())}) instead of the {len(ESSENTIAL_FIELDS)} essential ones",
+    )
 
 
 def _yaml_scalar(value) -> str:
@@ -19,13 +45,18 @@ def _yaml_scalar(value) -> str:
     return yaml.safe_dump(value, default_flow_style=True).removesuffix("\n...\n").strip()
 
 
-def render() -> str:
+def render(everything: bool = True) -> str:
+    """The YAML of every field (everything) or of ESSENTIAL_FIELDS, in the config's order."""
+    fields = _core.Config.fields()
+    which = "every parameter" if everything else f"the essential parameters ({len(fields)} with --all)"
     lines = [
-        "# farlio parameters: dotted names, defaults, units in the names. Pass with --config FILE",
-        "# or one at a time with --set name=value.",
+        f"# farlio: {which}: dotted names, defaults, units in the names. Pass with --config FILE",
+        "# or one at a time with --set name=value; a field left out keeps its default.",
     ]
     section = None
-    for name, default, doc, valid in _core.Config.fields():
+    for name, default, doc, valid in fields:
+        if not everything and name not in ESSENTIAL_FIELDS:
+            continue
         head, _, leaf = name.rpartition(".")
         if head != section:
             section = head
@@ -37,7 +68,7 @@ def render() -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    text = render()
+    text = render(args.all)
     if args.out:
         args.out.parent.mkdir(parents=True, exist_ok=True)
         args.out.write_text(text)
