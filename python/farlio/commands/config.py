@@ -11,7 +11,6 @@ import yaml
 
 from farlio import _core
 
-
 #: the fields a user sets for a sensor, a platform or a computer; the others are the method's own
 #: (docs/odometry.md, docs/fusion.md) and serve every sensor and dataset at their defaults
 ESSENTIAL_FIELDS = (
