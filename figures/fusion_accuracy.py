@@ -9,15 +9,15 @@ Each variant isolates one part of the fusion:
   lidar_only      no fusion (the reference the LIO must not be worse than)
   lio             the defaults
   paper_filter    the paper's filter: no bias states, the fixed LiDAR noise (the other
-                  variants run on it with --set fusion.estimate_imu_bias=false
+                  variants run on it with --set fusion.bias.estimate=false
                   fusion.lidar_information_from_registration=false)
   ideal_imu       the same scans, the IMU of the noise-free generator (no noise, no bias)
   ideal_gyro      ideal gyro, noisy accelerometer
   ideal_accel     noisy gyro, ideal accelerometer
-  no_ref_angles   fusion.reference_angles=false
-  no_delay_comp   fusion.delay_compensation=false
-  no_spread       fusion.update_spread_steps=1 (each LiDAR result in one update)
-  no_bias         fusion.standstill_bias=false
+  no_ref_angles   fusion.reference_angles.enabled=false
+  no_delay_comp   fusion.delay.compensation=false
+  no_spread       fusion.delay.spread_steps=1 (each LiDAR result in one update)
+  no_bias         fusion.standstill.gyro_bias=false
   fixed_noise     the LiDAR measurement from the fixed fusion.lidar_*_std values instead of the
                   registration's information matrix
 First, per seed, the spreads of the ground-truth positions along their principal axes (m). Columns:
@@ -54,7 +54,7 @@ from harness import fixed_latency, generated_sequence
 LINE_MIN_SPREAD_TO_RESIDUAL = 1000.0
 
 # the paper's filter: no bias states, the fixed LiDAR noise
-PAPER_FILTER = {"fusion.estimate_imu_bias": "false", "fusion.lidar_information_from_registration": "false"}
+PAPER_FILTER = {"fusion.bias.estimate": "false", "fusion.lidar_information_from_registration": "false"}
 VARIANTS: dict[str, tuple[dict[str, str], str]] = {
     # name: (config overrides, IMU source)
     "lidar_only": ({"fusion.enabled": "false"}, "noisy"),
@@ -63,10 +63,10 @@ VARIANTS: dict[str, tuple[dict[str, str], str]] = {
     "ideal_imu": ({}, "ideal"),
     "ideal_gyro": ({}, "ideal_gyro"),
     "ideal_accel": ({}, "ideal_accel"),
-    "no_ref_angles": ({"fusion.reference_angles": "false"}, "noisy"),
-    "no_delay_comp": ({"fusion.delay_compensation": "false"}, "noisy"),
-    "no_spread": ({"fusion.update_spread_steps": "1"}, "noisy"),
-    "no_bias": ({"fusion.standstill_bias": "false"}, "noisy"),
+    "no_ref_angles": ({"fusion.reference_angles.enabled": "false"}, "noisy"),
+    "no_delay_comp": ({"fusion.delay.compensation": "false"}, "noisy"),
+    "no_spread": ({"fusion.delay.spread_steps": "1"}, "noisy"),
+    "no_bias": ({"fusion.standstill.gyro_bias": "false"}, "noisy"),
     "tight_lidar": ({"fusion.lidar_roll_pitch_std_rad": "0.002", "fusion.lidar_yaw_std_rad": "0.002"}, "noisy"),
     "tight_convergence": ({"registration.convergence_norm": "0.001"}, "noisy"),
     "fixed_noise": ({"fusion.lidar_information_from_registration": "false"}, "noisy"),

@@ -5,7 +5,7 @@ tests/python/test_odometry.py, of docs/odometry.md, "Measured figures" ("Accurac
 ground truth") and of the urban and handheld rows of docs/fusion.md's Figures table.
 `--set NAME=VALUE` (repeatable) overrides a config field in both modes.
 
-    python figures/odometry_accuracy.py [--set fusion.standstill_max_speed_m_s=0.4 ...]
+    python figures/odometry_accuracy.py [--set fusion.standstill.max_speed_m_s=0.4 ...]
 """
 
 from __future__ import annotations

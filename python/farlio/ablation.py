@@ -18,7 +18,7 @@ ABLATION_ROWS = [
         "none",
         [
             "fusion.enabled=false",
-            "fusion.delay_compensation=false",
+            "fusion.delay.compensation=false",
             "preprocess.undistort=false",
             "registration.sparsity_aware=false",
             "density.enabled=false",
@@ -27,7 +27,7 @@ ABLATION_ROWS = [
     (
         "EKF",
         [
-            "fusion.delay_compensation=false",
+            "fusion.delay.compensation=false",
             "preprocess.undistort=false",
             "registration.sparsity_aware=false",
             "density.enabled=false",

@@ -1,7 +1,10 @@
 """The parameter set from Python: defaults, YAML files and `key=value` overrides.
 
-Field names are the dotted names of the C++ Config (e.g. ``map.voxel_size_m``); a YAML file may
-nest them (``map: {voxel_size_m: 2.0}``). Unknown names are errors that name the field.
+Field names are the dotted names of the C++ Config (e.g. ``map.voxel_size_m``,
+``fusion.reference_angles.roll_std_rad``); a YAML file may nest them at any level
+(``fusion: {reference_angles: {roll_std_rad: 0.2}}``) or write them dotted
+(``fusion: {reference_angles.roll_std_rad: 0.2}``). Unknown names are errors that name the field
+(and its new name when it moved into a sub-section).
 """
 
 from __future__ import annotations

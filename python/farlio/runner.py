@@ -187,7 +187,7 @@ class OdometryRun:
 
     def clock_check(self, first_scan_ns: int, last_scan_ns: int) -> Any:
         """The IMU's stamp span against the scans' (_core.check_clocks)."""
-        tolerance_s = self.config.get("fusion.max_bridged_gap_s")
+        tolerance_s = self.config.get("fusion.imu_gate.max_bridged_gap_s")
         return _core.check_clocks(*self.imu_span, first_scan_ns, last_scan_ns, tolerance_s)
 
     def check_clocks(self) -> None:
@@ -413,12 +413,13 @@ def _fusion_summary(stats: Any) -> dict[str, Any]:
         _warn(stats.accel_unit_message)
     if stats.imu_gaps:
         _warn(
-            f"{stats.imu_gaps} IMU gap(s): no sample for longer than fusion.imu_gap_limit_s (the last input was held)"
+            f"{stats.imu_gaps} IMU gap(s): no sample for longer than fusion.imu_gate.gap_limit_s "
+            "(the last input was held)"
         )
     if stats.imu_samples_rejected:
         _warn(
             f"{stats.imu_samples_rejected} IMU sample(s) rejected as non-finite, impossible or spikes "
-            f"(fusion.imu_max_*, fusion.imu_spike_*); the last: {stats.last_warning}"
+            f"(fusion.imu_gate.max_*, fusion.imu_gate.spike_*); the last: {stats.last_warning}"
         )
     init = stats.initialization
     up = np.asarray(stats.up_map, dtype=float)

@@ -137,8 +137,8 @@ inline SimResult simulate(const TestTrajectory& traj, const FusionConfig& config
 /// A configuration without the optional parts (pure prediction + LiDAR updates).
 inline FusionConfig plain_config() {
   FusionConfig c;
-  c.reference_angles = false;
-  c.standstill_bias = false;
+  c.reference_angles.enabled = false;
+  c.standstill.gyro_bias = false;
   return c;
 }
 

@@ -43,6 +43,34 @@ TEST(Config, SetChangesTheStructAndNamesUnknownFields) {
   EXPECT_THROW(set_config_field(c, "density.enabled", "maybe"), std::invalid_argument);
 }
 
+TEST(Config, FusionSubSectionsAreThreeLevelNames) {
+  Config c;
+  set_config_field(c, "fusion.reference_angles.roll_std_rad", "0.2");
+  set_config_field(c, "fusion.bias.estimate", "false");
+  set_config_field(c, "fusion.units.accel_samples", "20");
+  EXPECT_DOUBLE_EQ(c.fusion.reference_angles.roll_std_rad, 0.2);
+  EXPECT_FALSE(c.fusion.bias.estimate);
+  EXPECT_EQ(c.fusion.units.accel_samples, 20);
+  EXPECT_EQ(get_config_field(c, "fusion.reference_angles.roll_std_rad"), "0.2");
+}
+
+TEST(Config, ARenamedFieldIsUnknownAndItsErrorNamesTheNewName) {
+  const auto& renamed = renamed_config_fields();
+  ASSERT_EQ(renamed.size(), 39u);
+  for (const auto& [old_name, new_name] : renamed) {
+    Config c;
+    EXPECT_NO_THROW(get_config_field(c, std::string(new_name))) << new_name;
+    try {
+      set_config_field(c, std::string(old_name), "1");
+      ADD_FAILURE() << old_name << " was accepted";
+    } catch (const std::invalid_argument& e) {
+      const std::string expected =
+          "unknown config field '" + std::string(old_name) + "' (renamed to " + std::string(new_name) + ")";
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(Config, TheDefaultsAreValidAndInsideTheirRanges) {
   Config c;
   EXPECT_NO_THROW(validate_config(c));
@@ -112,12 +140,12 @@ INSTANTIATE_TEST_SUITE_P(Fields, ConfigBadValue,
                                            BadValue{"preprocess.min_range_m", "nan", "in [0, 10000]"},
                                            BadValue{"map.covariance_neighbors", "33", "in [1, 32]"},
                                            BadValue{"registration.max_iterations", "0", "in [1, 1e+06]"},
-                                           BadValue{"fusion.reference_max_sin", "1.5", "in (0, 1]"},
+                                           BadValue{"fusion.reference_angles.max_sin", "1.5", "in (0, 1]"},
                                            BadValue{"num_threads", "-2", "in [0, 1024]"},
                                            BadValue{"map.max_voxel_capacity", "0", "in [1, 2147483647]"},
-                                           BadValue{"fusion.gyro_bias_init_x_rad_s", "inf", "in [-1, 1]"},
+                                           BadValue{"fusion.bias.gyro_init_x_rad_s", "inf", "in [-1, 1]"},
                                            BadValue{"fusion.history_s", "1e12", "in (0, 60]"},
-                                           BadValue{"fusion.imu_gap_limit_s", "1e15", "in (0, 60]"},
+                                           BadValue{"fusion.imu_gate.gap_limit_s", "1e15", "in (0, 60]"},
                                            BadValue{"preprocess.max_range_m", "0", "in (0, 10000] or inf"}));
 
 TEST(Config, InfinityMeansNoLimitWhereTheRangeSaysSo) {
@@ -150,8 +178,8 @@ TEST(Config, ValidateCatchesFieldsSetDirectlyAndRulesBetweenFields) {
   EXPECT_NE(message_of(c).find("preprocess.min_range_m (300) must be below preprocess.max_range_m (200)"),
             std::string::npos);
   c = Config();
-  c.fusion.reference_filter_taps = 10;
-  EXPECT_NE(message_of(c).find("fusion.reference_filter_taps must be odd"), std::string::npos);
+  c.fusion.reference_angles.filter_taps = 10;
+  EXPECT_NE(message_of(c).find("fusion.reference_angles.filter_taps must be odd"), std::string::npos);
   c = Config();
   c.map.initial_voxel_capacity = c.map.max_voxel_capacity + 1;
   EXPECT_NE(message_of(c).find("map.initial_voxel_capacity"), std::string::npos);

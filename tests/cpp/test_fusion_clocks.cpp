@@ -584,7 +584,7 @@ TEST(OnlineClocks, AResultFarBehindTheImuClockDoesNotInitialiseTheFilter) {
   });
   ASSERT_EQ(run.frames.size(), 2u);
   EXPECT_FALSE(run.frames[1].fused);
-  EXPECT_NE(run.frames[1].drop_reason.find("beyond fusion.max_bridged_gap_s"), std::string::npos)
+  EXPECT_NE(run.frames[1].drop_reason.find("beyond fusion.imu_gate.max_bridged_gap_s"), std::string::npos)
       << run.frames[1].drop_reason;
   EXPECT_TRUE(run.outputs.empty() || run.outputs.size() < 10u);
 }

@@ -62,7 +62,7 @@ TEST(FusionParts, GyroBiasConvergesAtStandstill) {
   o.gyro_bias_rad_s = Eigen::Vector3d(0.003, -0.002, 0.001);
   o.gyro_noise_std_rad_s = 0.002;
   o.accel_noise_std_m_s2 = 0.02;
-  FusionConfig c;  // defaults: standstill_bias on
+  FusionConfig c;  // defaults: standstill.gyro_bias on
   const SimResult r = simulate(still, c, o);
   const Eigen::Vector3d err = r.stats.gyro_bias_rad_s - o.gyro_bias_rad_s;
   for (int i = 0; i < 3; ++i) {
@@ -71,10 +71,10 @@ TEST(FusionParts, GyroBiasConvergesAtStandstill) {
   EXPECT_GT(r.stats.bias_samples, 5000);
   std::printf("standstill bias estimate %.5f %.5f %.5f rad/s from %lld samples\n", r.stats.gyro_bias_rad_s.x(),
               r.stats.gyro_bias_rad_s.y(), r.stats.gyro_bias_rad_s.z(), static_cast<long long>(r.stats.bias_samples));
-  c.standstill_bias = false;  // the bias state of the filter alone learns it from the LiDAR attitude
+  c.standstill.gyro_bias = false;  // the bias state of the filter alone learns it from the LiDAR attitude
   const Eigen::Vector3d filter_err = simulate(still, c, o).stats.gyro_bias_rad_s - o.gyro_bias_rad_s;
   EXPECT_LT(filter_err.cwiseAbs().maxCoeff(), 3e-4) << filter_err.transpose();
-  c.estimate_imu_bias = false;  // ablation (the paper's filter): the bias stays at its initial value
+  c.bias.estimate = false;  // ablation (the paper's filter): the bias stays at its initial value
   EXPECT_EQ(simulate(still, c, o).stats.gyro_bias_rad_s, Eigen::Vector3d::Zero());
 }
 

@@ -105,7 +105,7 @@ TEST(FusionSensor, OutlierPositionIsRejectedPerGroup) {
 
 TEST(FusionSensor, OutlierPoseLeavesTheEstimateUnchanged) {
   FusionConfig c = matched_config();
-  c.update_spread_steps = 10;  // the same N in both runs
+  c.delay.spread_steps = 10;  // the same N in both runs
   SimOptions o = noisy_options(12.0);
   o.outlier_index = 100;  // 5 m and 20 deg off: every group is an outlier
   o.outlier_offset_m = Eigen::Vector3d(5.0, 0.0, 0.0);
@@ -132,7 +132,7 @@ TEST(FusionSensor, DelayCompensationMatchesTheUndelayedRun) {
   FusionConfig on = matched_config();
   on.outlier_rejection = false;  // compare the corrections themselves, not the gate
   FusionConfig off = on;
-  off.delay_compensation = false;
+  off.delay.compensation = false;
   SimOptions o = noisy_options(10.0);
   const SimResult undelayed = simulate(fast_curve(), on, o);
   o.lidar_delay_s = 0.05;
@@ -163,7 +163,7 @@ TEST(FusionSensor, DelayCompensationMatchesTheUndelayedRun) {
 
 TEST(FusionSensor, SpreadingUpdatesSmoothsTheOutput) {
   FusionConfig one_shot = matched_config();
-  one_shot.update_spread_steps = 1;
+  one_shot.delay.spread_steps = 1;
   FusionConfig spread = matched_config();  // automatic N = LiDAR period / step = 10
   const SimOptions o = noisy_options(10.0);
   const SimResult a = simulate(fast_curve(), one_shot, o);

@@ -40,11 +40,11 @@ TEST(ImuGate, CorruptSamplesAreRejectedWithTheirField) {
     const char* names;  // what the reason must mention
   };
   const Case cases[] = {
-      {{1e30, 0.0, 9.81}, {0.0, 0.0, 0.5}, "fusion.imu_max_accel_m_s2"},    // a bit flip
-      {{1e4, 0.0, 9.81}, {0.0, 0.0, 0.5}, "fusion.imu_max_accel_m_s2"},     // a 1e4 m/s^2 spike
-      {{0.0, 0.0, 9.81}, {0.0, 0.0, 40.0}, "fusion.imu_max_gyro_rad_s"},    // over full scale
-      {{0.0, 0.0, 9.81}, {30.0, 0.0, 0.5}, "fusion.imu_spike_gyro_rad_s"},  // within full scale: a spike
-      {{90.0, 0.0, 9.81}, {0.0, 0.0, 0.5}, "fusion.imu_spike_accel_m_s2"},  // within full scale: a spike
+      {{1e30, 0.0, 9.81}, {0.0, 0.0, 0.5}, "fusion.imu_gate.max_accel_m_s2"},    // a bit flip
+      {{1e4, 0.0, 9.81}, {0.0, 0.0, 0.5}, "fusion.imu_gate.max_accel_m_s2"},     // a 1e4 m/s^2 spike
+      {{0.0, 0.0, 9.81}, {0.0, 0.0, 40.0}, "fusion.imu_gate.max_gyro_rad_s"},    // over full scale
+      {{0.0, 0.0, 9.81}, {30.0, 0.0, 0.5}, "fusion.imu_gate.spike_gyro_rad_s"},  // within full scale: a spike
+      {{90.0, 0.0, 9.81}, {0.0, 0.0, 0.5}, "fusion.imu_gate.spike_accel_m_s2"},  // within full scale: a spike
       {{nan, 0.0, 9.81}, {0.0, 0.0, 0.5}, "non-finite"},
   };
   for (const Case& c : cases) {
@@ -66,11 +66,11 @@ TEST(ImuGate, ARealStepPassesOnceItHasLastedHalfTheWindow) {
   for (; k < 50; ++k) ASSERT_EQ(gate.check(sample(k, {0.0, 0.0, 9.81}, Eigen::Vector3d::Zero()), 1.0), "");
   // the gyro jumps to 12 rad/s and stays (a hard turn-in): a spike at first, then the signal
   int rejected = 0;
-  for (int i = 0; i < 2 * config.imu_spike_window_samples; ++i, ++k) {
+  for (int i = 0; i < 2 * config.imu_gate.spike_window_samples; ++i, ++k) {
     rejected += !gate.check(sample(k, {0.0, 0.0, 9.81}, {0.0, 0.0, 12.0}), 1.0).empty();
   }
   EXPECT_GT(rejected, 0);
-  EXPECT_LE(rejected, config.imu_spike_window_samples / 2 + 1);
+  EXPECT_LE(rejected, config.imu_gate.spike_window_samples / 2 + 1);
 }
 
 TEST(ImuGate, AnAccelerometerInGIsJudgedInMetresPerSecondSquared) {

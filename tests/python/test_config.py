@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 import pytest
 import yaml
@@ -61,8 +62,8 @@ def test_rules_between_fields_are_checked_when_loading(tmp_path):
     ):
         load_config(overrides=["preprocess.min_range_m=300"])
     f = tmp_path / "bad.yaml"
-    f.write_text("fusion:\n  reference_filter_taps: 4\n")
-    with pytest.raises(ValueError, match="reference_filter_taps must be odd"):
+    f.write_text("fusion:\n  reference_angles:\n    filter_taps: 4\n")
+    with pytest.raises(ValueError, match=r"fusion\.reference_angles\.filter_taps must be odd"):
         load_config(f)
 
 
@@ -74,6 +75,7 @@ def test_the_written_yaml_reads_back_to_the_same_config(tmp_path):
             "registration.damping=1e-7",
             "device=cpu",
             "registration.time_budget_factor=inf",
+            "fusion.reference_angles.roll_std_rad=0.3",
         ]
     )
     f = tmp_path / "config.yaml"
@@ -81,6 +83,44 @@ def test_the_written_yaml_reads_back_to_the_same_config(tmp_path):
     back = load_config(f)
     assert back == cfg
     assert back != _core.Config()
+
+
+def test_sections_nest_three_levels_deep_or_take_dotted_keys(tmp_path):
+    """A field of a sub-section (fusion.reference_angles.roll_std_rad) is read from nested mappings,
+    from a dotted key at any level, or from the full dotted name."""
+    expected = load_config(overrides=["fusion.step_s=0.02", "fusion.reference_angles.roll_std_rad=0.2"])
+    assert expected.get("fusion.reference_angles.roll_std_rad") == 0.2
+    texts = (
+        "fusion:\n  step_s: 0.02\n  reference_angles:\n    roll_std_rad: 0.2\n",
+        "fusion:\n  step_s: 0.02\n  reference_angles.roll_std_rad: 0.2\n",
+        "fusion.step_s: 0.02\nfusion.reference_angles.roll_std_rad: 0.2\n",
+    )
+    for i, text in enumerate(texts):
+        f = tmp_path / f"config{i}.yaml"
+        f.write_text(text)
+        assert load_config(f) == expected, text
+
+
+@pytest.mark.parametrize(
+    "old,new",
+    [
+        ("fusion.reference_roll_std_rad", "fusion.reference_angles.roll_std_rad"),
+        ("fusion.estimate_imu_bias", "fusion.bias.estimate"),
+        ("fusion.imu_gap_limit_s", "fusion.imu_gate.gap_limit_s"),
+    ],
+)
+def test_a_renamed_field_is_an_error_that_names_its_new_name(tmp_path, old, new):
+    """An old name, on the command line or in a YAML file, is an unknown field whose error names
+    the field's new place."""
+    expected = rf"unknown config field '{re.escape(old)}' \(renamed to {re.escape(new)}\)"
+    with pytest.raises(ValueError, match=expected):
+        load_config(overrides=[f"{old}=1"])
+    section, leaf = old.split(".")
+    f = tmp_path / "old.yaml"
+    f.write_text(f"{section}:\n  {leaf}: 1\n")
+    with pytest.raises(ValueError, match=expected):
+        load_config(f)
+    assert new in _core.Config().to_dict()
 
 
 def test_fields_list_defaults_docs_and_ranges():
@@ -104,8 +144,13 @@ def test_farlio_config_prints_the_essential_fields_or_all_and_reads_back(tmp_pat
     assert set(ESSENTIAL_FIELDS) <= set(names) and len(set(ESSENTIAL_FIELDS)) == len(ESSENTIAL_FIELDS)
     out = tmp_path / "config.yaml"
     assert main(["config", "--out", str(out), *(["--all"] if everything else [])]) == 0
-    written = set()
-    for key, value in yaml.safe_load(out.read_text()).items():
-        written |= {f"{key}.{leaf}" for leaf in value} if isinstance(value, dict) else {key}
-    assert written == (set(names) if everything else set(ESSENTIAL_FIELDS))
+
+    def leaves(node: dict, prefix: str = ""):
+        for key, value in node.items():
+            yield from leaves(value, f"{prefix}{key}.") if isinstance(value, dict) else [f"{prefix}{key}"]
+
+    written = list(leaves(yaml.safe_load(out.read_text())))
+    assert len(written) == len(set(written))
+    assert set(written) == (set(names) if everything else set(ESSENTIAL_FIELDS))
+    assert ("fusion.reference_angles.roll_std_rad" in written) == everything
     assert load_config(out) == _core.Config()

@@ -72,14 +72,14 @@ def one_line_error(capsys, *fragments: str) -> str:
     [
         ("fusion.step_s", "0", "in [1e-04, 1], got 0"),
         ("fusion.history_s", "1e12", "in (0, 60], got 1e+12"),
-        ("fusion.imu_gap_limit_s", "1e15", "in (0, 60], got 1e+15"),
+        ("fusion.imu_gate.gap_limit_s", "1e15", "in (0, 60], got 1e+15"),
         ("map.voxel_size_m", "nan", "in [0.01, 100], got nan"),
         ("registration.max_iterations", "0", "in [1, 1e+06], got 0"),
         ("registration.convergence_norm", "nan", "in (0, 1000], got nan"),
         ("threshold.max_threshold_m", "0", "in (0, 1000], got 0"),
         ("registration.time_budget_factor", "0", "in (0, 1e+06] or inf, got 0"),
         ("preprocess.max_range_m", "0", "in (0, 10000] or inf, got 0"),
-        ("fusion.max_bridged_gap_s", "-1", "in (0, 60], got -1"),
+        ("fusion.imu_gate.max_bridged_gap_s", "-1", "in (0, 60], got -1"),
     ],
 )
 def test_a_bad_value_names_the_field_its_value_and_range(name, value, message):
@@ -97,9 +97,9 @@ def test_every_numeric_field_has_a_finite_range():
 
 def test_a_rule_between_fields_gives_both_values():
     with pytest.raises(
-        ValueError, match=r"fusion.imu_gap_limit_s \(2\) must not exceed fusion.max_bridged_gap_s \(1\)"
+        ValueError, match=r"fusion.imu_gate.gap_limit_s \(2\) must not exceed fusion.imu_gate.max_bridged_gap_s \(1\)"
     ):
-        load_config(overrides=["fusion.imu_gap_limit_s=2"])
+        load_config(overrides=["fusion.imu_gate.gap_limit_s=2"])
 
 
 def test_invalid_yaml_names_the_file_and_line(sequence, tmp_path, capsys):

@@ -8,7 +8,8 @@
 // Each section is one list, the only place a field is written down:
 //   FIELD(type, name, default, valid range (config_range.hpp), documentation)
 // The list declares the struct's members with their defaults (below) and gives config_fields.cpp
-// the dotted names, the documentation and the validation.
+// the dotted names, the documentation and the validation. A section may hold sub-sections, each
+// its own list and struct, named one level deeper (`fusion.reference_angles.roll_std_rad`).
 #include <cstdint>
 
 #include "farlio/core/config_range.hpp"
@@ -167,7 +168,9 @@ inline constexpr double kMaxThreads = 1024.0;
         "after failed registrations for this long, the map restarts from the current scan at the prediction")
 
 // ---- fusion: the kinematic EKF (paper eqs. 7-10) fusing IMU inputs with LiDAR poses -------------
-// Variances are given as standard deviations (unit in the name); docs/fusion.md explains each.
+// Variances are given as standard deviations (unit in the name); docs/fusion.md explains each. The
+// filter's own fields are listed here, its parts in the sub-sections below (fusion.init, fusion.bias,
+// fusion.imu_gate, fusion.reference_angles, fusion.delay, fusion.standstill, fusion.units).
 #define FARLIO_FUSION_FIELDS(FIELD)                                                                                   \
   FIELD(bool, enabled, true, range::unchecked(), "fuse the IMU (LIO); false or no IMU: LiDAR-only odometry")          \
   FIELD(double, step_s, 0.01, range::between(1e-4, 1.0), "fixed EKF step and odometry output period (paper: 100 Hz)") \
@@ -175,26 +178,12 @@ inline constexpr double kMaxThreads = 1024.0;
         "state history kept for delay compensation and pose queries")                                                 \
   FIELD(double, max_extrapolation_s, 0.1, range::non_negative_up_to(kMaxDuration_s),                                  \
         "a pose may be predicted this far beyond the newest step")                                                    \
-  FIELD(double, imu_gap_limit_s, 0.1, range::positive_up_to(kMaxDuration_s),                                          \
-        "IMU samples farther apart are a gap: the last input is held")                                                \
-  FIELD(double, max_bridged_gap_s, 1.0, range::positive_up_to(kMaxDuration_s),                                        \
-        "largest jump of the IMU clock the fusion takes: a gap up to this is predicted across, a sample up to this "  \
-        "older than the newest is dropped; a larger jump either way resets the fusion with a warning (it starts "     \
-        "again from the next LiDAR result), and a LiDAR result older than the IMU clock by more does not "            \
-        "initialise the filter")                                                                                      \
   FIELD(double, gyro_input_std_rad_s, 0.02, range::positive_up_to(kMaxSiValue),                                       \
         "std of the gyro input averaged over one step, process noise B Q B^T "                                        \
         "(reference: variances 3e-4..3e-3 rad^2/s^2 at 100 Hz)")                                                      \
   FIELD(double, accel_input_std_m_s2, 1.0, range::positive_up_to(kMaxSiValue),                                        \
         "std of the accelerometer input averaged over one step, process noise B Q B^T "                               \
         "(reference: variances 1..4 m^2/s^4 at 100 Hz)")                                                              \
-  FIELD(double, initial_position_std_m, 0.1, range::positive_up_to(kMaxSiValue),                                      \
-        "position std at initialisation (the first LiDAR pose)")                                                      \
-  FIELD(double, initial_attitude_std_rad, 0.02, range::positive_up_to(kMaxSiValue),                                   \
-        "roll/pitch/yaw std at initialisation")                                                                       \
-  FIELD(double, init_window_s, 0.7, range::positive_up_to(kMaxDuration_s),                                            \
-        "the filter starts from the LiDAR results of its first scans and the IMU between them: at rest from two, in " \
-        "motion from those of this span (gravity in the map frame and the velocity, fusion/initialization.hpp)")      \
   FIELD(double, lidar_position_std_m, 0.05, range::positive_up_to(kMaxSiValue),                                       \
         "LiDAR position measurement std per axis")                                                                    \
   FIELD(double, lidar_roll_pitch_std_rad, 0.02, range::positive_up_to(kMaxSiValue),                                   \
@@ -209,25 +198,6 @@ inline constexpr double kMaxThreads = 1024.0;
         "floor of the registration's position std per axis")                                                          \
   FIELD(double, lidar_min_attitude_std_rad, 2e-4, range::positive_up_to(kMaxSiValue),                                 \
         "floor of the registration's attitude std")                                                                   \
-  FIELD(bool, estimate_imu_bias, true, range::unchecked(),                                                            \
-        "gyro and accelerometer biases as filter states (false: the paper's 9-state filter)")                         \
-  FIELD(double, gyro_bias_std_rad_s, 0.01, range::positive_up_to(kMaxSiValue), "initial std of the gyro bias state")  \
-  FIELD(double, accel_bias_std_m_s2, 0.1, range::positive_up_to(kMaxSiValue),                                         \
-        "initial std of the accelerometer bias state")                                                                \
-  FIELD(double, gyro_bias_walk_rad_s2_sqrt_hz, 2e-4, range::non_negative_up_to(kMaxSiValue),                          \
-        "gyro bias random walk density")                                                                              \
-  FIELD(double, accel_bias_walk_m_s3_sqrt_hz, 2e-3, range::non_negative_up_to(kMaxSiValue),                           \
-        "accelerometer bias random walk density")                                                                     \
-  FIELD(double, imu_max_accel_m_s2, 160.0, range::positive_up_to(kMaxSiValue),                                        \
-        "an IMU sample with |accel| over this is impossible and rejected (16 g: MEMS full scale)")                    \
-  FIELD(double, imu_max_gyro_rad_s, 35.0, range::positive_up_to(kMaxSiValue),                                         \
-        "an IMU sample with |gyro| over this is impossible and rejected (2000 deg/s: MEMS full scale)")               \
-  FIELD(double, imu_spike_accel_m_s2, 50.0, range::positive_up_to(kMaxSiValue),                                       \
-        "an accelerometer axis this far from the median of the recent samples is a spike: rejected")                  \
-  FIELD(double, imu_spike_gyro_rad_s, 10.0, range::positive_up_to(kMaxSiValue),                                       \
-        "a gyro axis this far from the median of the recent samples is a spike: rejected")                            \
-  FIELD(int, imu_spike_window_samples, 9, range::between(0, kMaxCount),                                               \
-        "samples in the spike median (0: no spike test); a real step passes after half of them")                      \
   FIELD(bool, outlier_rejection, true, range::unchecked(), "Mahalanobis outlier rejection per measurement group")     \
   FIELD(double, outlier_chi2_3dof, 16.27, range::positive_up_to(kMaxRatio),                                           \
         "chi-square gate of 3-dof groups (99.9 % quantile)")                                                          \
@@ -236,50 +206,105 @@ inline constexpr double kMaxThreads = 1024.0;
   FIELD(double, outlier_chi2_6dof, 22.46, range::positive_up_to(kMaxRatio),                                           \
         "chi-square gate of 6-dof groups (99.9 % quantile)")                                                          \
   FIELD(int, max_consecutive_rejections, 10, range::between(1, kMaxCount),                                            \
-        "LiDAR positions rejected in a row before the filter re-initialises from the LiDAR pose")                     \
-  FIELD(bool, reference_angles, true, range::unchecked(),                                                             \
-        "fuse roll/pitch reference angles, a pseudo-measurement from gravity in the body frame")                      \
-  FIELD(double, reference_roll_std_rad, 0.22, range::positive_up_to(kMaxSiValue),                                     \
-        "reference roll std (reference: variance 0.05 rad^2)")                                                        \
-  FIELD(double, reference_pitch_std_rad, 0.32, range::positive_up_to(kMaxSiValue),                                    \
-        "reference pitch std (reference: variance 0.1 rad^2)")                                                        \
-  FIELD(int, reference_filter_taps, 11, range::between(1, kMaxCount),                                                 \
-        "taps of the Hann low-pass of the reference angle terms (odd)")                                               \
-  FIELD(double, reference_max_sin, 0.5, range::fraction(),                                                            \
-        "clamp of the asin argument (30 deg); clamped reference angles are not fused")                                \
-  FIELD(bool, delay_compensation, true, range::unchecked(), "shift delayed measurements by eq. (10)")                 \
-  FIELD(int, update_spread_steps, 0, range::non_negative_up_to(kMaxCount),                                            \
-        "N: a LiDAR result is injected over N steps with N R each; 0: the LiDAR period / step_s")                     \
-  FIELD(int, max_update_spread_steps, 20, range::between(1, kMaxCount), "cap of the automatic N")                     \
-  FIELD(bool, standstill_bias, true, range::unchecked(),                                                              \
-        "learn the gyro bias at standstill (the accelerometer bias stays at its initial value, as in the paper)")     \
-  FIELD(double, standstill_max_speed_m_s, 0.1, range::non_negative_up_to(kMaxSiValue),                                \
-        "standstill: estimated speed below this (a walk's first steps are slower than 0.4 m/s)")                      \
-  FIELD(double, standstill_max_gyro_rad_s, 0.05, range::non_negative_up_to(kMaxSiValue),                              \
-        "standstill: |gyro| below this")                                                                              \
-  FIELD(double, standstill_max_accel_deviation_m_s2, 1.0, range::non_negative_up_to(kMaxSiValue),                     \
-        "standstill: | |accel| - g | below this")                                                                     \
-  FIELD(int, bias_window_samples, 10000, range::between(1, kMaxCount),                                                \
-        "gyro bias running mean over at most this many samples")                                                      \
-  FIELD(int, bias_prior_samples, 100, range::non_negative_up_to(kMaxCount),                                           \
-        "weight of the initial gyro bias in the mean, in samples")                                                    \
-  FIELD(double, gyro_bias_init_x_rad_s, 0.0, range::symmetric(kMaxGyroBias_rad_s), "initial gyro bias x")             \
-  FIELD(double, gyro_bias_init_y_rad_s, 0.0, range::symmetric(kMaxGyroBias_rad_s), "initial gyro bias y")             \
-  FIELD(double, gyro_bias_init_z_rad_s, 0.0, range::symmetric(kMaxGyroBias_rad_s), "initial gyro bias z")             \
-  FIELD(double, accel_bias_x_m_s2, 0.0, range::symmetric(kMaxAccelBias_m_s2),                                         \
-        "accelerometer bias x (not estimated, as in the paper)")                                                      \
-  FIELD(double, accel_bias_y_m_s2, 0.0, range::symmetric(kMaxAccelBias_m_s2),                                         \
-        "accelerometer bias y (not estimated, as in the paper)")                                                      \
-  FIELD(double, accel_bias_z_m_s2, 0.0, range::symmetric(kMaxAccelBias_m_s2),                                         \
-        "accelerometer bias z (not estimated, as in the paper)")                                                      \
-  FIELD(bool, accel_unit_detection, true, range::unchecked(), "detect an accelerometer reporting in g and scale it")  \
-  FIELD(int, accel_unit_detection_samples, 50, range::between(1, kMaxCount),                                          \
-        "the mean |accel| of these first samples decides the unit")                                                   \
-  FIELD(bool, gyro_unit_detection, true, range::unchecked(),                                                          \
-        "detect a gyro reporting in deg/s (its rotation ~57x the LiDAR's) and scale it; a gyro that stays "           \
-        "constant while the LiDAR turns is not used")                                                                 \
-  FIELD(double, gyro_unit_min_rotation_rad, 0.1, range::positive_up_to(kMaxSiValue),                                  \
-        "the gyro unit is decided once the gyro's or the LiDAR's rotation over the scans reaches this; until then "   \
+        "LiDAR positions rejected in a row before the filter re-initialises from the LiDAR pose")
+
+// ---- fusion.init: the filter's start (fusion/initialization.hpp) --------------------------------
+#define FARLIO_FUSION_INIT_FIELDS(FIELD)                                                                              \
+  FIELD(double, position_std_m, 0.1, range::positive_up_to(kMaxSiValue),                                              \
+        "position std at initialisation (the first LiDAR pose)")                                                      \
+  FIELD(double, attitude_std_rad, 0.02, range::positive_up_to(kMaxSiValue), "roll/pitch/yaw std at initialisation")   \
+  FIELD(double, window_s, 0.7, range::positive_up_to(kMaxDuration_s),                                                 \
+        "the filter starts from the LiDAR results of its first scans and the IMU between them: at rest from two, in " \
+        "motion from those of this span (gravity in the map frame and the velocity, fusion/initialization.hpp)")
+
+// ---- fusion.bias: the IMU biases (filter states and the fixed initial values) -------------------
+#define FARLIO_FUSION_BIAS_FIELDS(FIELD)                                                                        \
+  FIELD(bool, estimate, true, range::unchecked(),                                                               \
+        "gyro and accelerometer biases as filter states (false: the paper's 9-state filter)")                   \
+  FIELD(double, gyro_std_rad_s, 0.01, range::positive_up_to(kMaxSiValue), "initial std of the gyro bias state") \
+  FIELD(double, accel_std_m_s2, 0.1, range::positive_up_to(kMaxSiValue),                                        \
+        "initial std of the accelerometer bias state")                                                          \
+  FIELD(double, gyro_walk_rad_s2_sqrt_hz, 2e-4, range::non_negative_up_to(kMaxSiValue),                         \
+        "gyro bias random walk density")                                                                        \
+  FIELD(double, accel_walk_m_s3_sqrt_hz, 2e-3, range::non_negative_up_to(kMaxSiValue),                          \
+        "accelerometer bias random walk density")                                                               \
+  FIELD(double, gyro_init_x_rad_s, 0.0, range::symmetric(kMaxGyroBias_rad_s), "initial gyro bias x")            \
+  FIELD(double, gyro_init_y_rad_s, 0.0, range::symmetric(kMaxGyroBias_rad_s), "initial gyro bias y")            \
+  FIELD(double, gyro_init_z_rad_s, 0.0, range::symmetric(kMaxGyroBias_rad_s), "initial gyro bias z")            \
+  FIELD(double, accel_init_x_m_s2, 0.0, range::symmetric(kMaxAccelBias_m_s2),                                   \
+        "accelerometer bias x subtracted from every sample (fixed, as in the paper; with "                      \
+        "fusion.bias.estimate the filter's bias state adds to it)")                                             \
+  FIELD(double, accel_init_y_m_s2, 0.0, range::symmetric(kMaxAccelBias_m_s2),                                   \
+        "accelerometer bias y subtracted from every sample (fixed, as in the paper; with "                      \
+        "fusion.bias.estimate the filter's bias state adds to it)")                                             \
+  FIELD(double, accel_init_z_m_s2, 0.0, range::symmetric(kMaxAccelBias_m_s2),                                   \
+        "accelerometer bias z subtracted from every sample (fixed, as in the paper; with "                      \
+        "fusion.bias.estimate the filter's bias state adds to it)")
+
+// ---- fusion.imu_gate: IMU clock gaps and implausible samples (fusion/imu_gate.hpp) -------------
+#define FARLIO_FUSION_IMU_GATE_FIELDS(FIELD)                                                                         \
+  FIELD(double, gap_limit_s, 0.1, range::positive_up_to(kMaxDuration_s),                                             \
+        "IMU samples farther apart are a gap: the last input is held")                                               \
+  FIELD(double, max_bridged_gap_s, 1.0, range::positive_up_to(kMaxDuration_s),                                       \
+        "largest jump of the IMU clock the fusion takes: a gap up to this is predicted across, a sample up to this " \
+        "older than the newest is dropped; a larger jump either way resets the fusion with a warning (it starts "    \
+        "again from the next LiDAR result), and a LiDAR result older than the IMU clock by more does not "           \
+        "initialise the filter")                                                                                     \
+  FIELD(double, max_accel_m_s2, 160.0, range::positive_up_to(kMaxSiValue),                                           \
+        "an IMU sample with |accel| over this is impossible and rejected (16 g: MEMS full scale)")                   \
+  FIELD(double, max_gyro_rad_s, 35.0, range::positive_up_to(kMaxSiValue),                                            \
+        "an IMU sample with |gyro| over this is impossible and rejected (2000 deg/s: MEMS full scale)")              \
+  FIELD(double, spike_accel_m_s2, 50.0, range::positive_up_to(kMaxSiValue),                                          \
+        "an accelerometer axis this far from the median of the recent samples is a spike: rejected")                 \
+  FIELD(double, spike_gyro_rad_s, 10.0, range::positive_up_to(kMaxSiValue),                                          \
+        "a gyro axis this far from the median of the recent samples is a spike: rejected")                           \
+  FIELD(int, spike_window_samples, 9, range::between(0, kMaxCount),                                                  \
+        "samples in the spike median (0: no spike test); a real step passes after half of them")
+
+// ---- fusion.reference_angles: roll/pitch from gravity, a pseudo-measurement ---------------------
+#define FARLIO_FUSION_REFERENCE_ANGLES_FIELDS(FIELD)                                             \
+  FIELD(bool, enabled, true, range::unchecked(),                                                 \
+        "fuse roll/pitch reference angles, a pseudo-measurement from gravity in the body frame") \
+  FIELD(double, roll_std_rad, 0.22, range::positive_up_to(kMaxSiValue),                          \
+        "reference roll std (reference: variance 0.05 rad^2)")                                   \
+  FIELD(double, pitch_std_rad, 0.32, range::positive_up_to(kMaxSiValue),                         \
+        "reference pitch std (reference: variance 0.1 rad^2)")                                   \
+  FIELD(int, filter_taps, 11, range::between(1, kMaxCount),                                      \
+        "taps of the Hann low-pass of the reference angle terms (odd)")                          \
+  FIELD(double, max_sin, 0.5, range::fraction(),                                                 \
+        "clamp of the asin argument (30 deg); clamped reference angles are not fused")
+
+// ---- fusion.delay: delayed LiDAR results (eq. 10) -----------------------------------------------
+#define FARLIO_FUSION_DELAY_FIELDS(FIELD)                                                         \
+  FIELD(bool, compensation, true, range::unchecked(), "shift delayed measurements by eq. (10)")   \
+  FIELD(int, spread_steps, 0, range::non_negative_up_to(kMaxCount),                               \
+        "N: a LiDAR result is injected over N steps with N R each; 0: the LiDAR period / step_s") \
+  FIELD(int, max_spread_steps, 20, range::between(1, kMaxCount), "cap of the automatic N")
+
+// ---- fusion.standstill: the gyro bias learnt at standstill (fusion/standstill_bias.hpp) ---------
+#define FARLIO_FUSION_STANDSTILL_FIELDS(FIELD)                                                                    \
+  FIELD(bool, gyro_bias, true, range::unchecked(),                                                                \
+        "learn the gyro bias at standstill (the accelerometer bias stays at its initial value, as in the paper)") \
+  FIELD(double, max_speed_m_s, 0.1, range::non_negative_up_to(kMaxSiValue),                                       \
+        "standstill: estimated speed below this (a walk's first steps are slower than 0.4 m/s)")                  \
+  FIELD(double, max_gyro_rad_s, 0.05, range::non_negative_up_to(kMaxSiValue), "standstill: |gyro| below this")    \
+  FIELD(double, max_accel_deviation_m_s2, 1.0, range::non_negative_up_to(kMaxSiValue),                            \
+        "standstill: | |accel| - g | below this")                                                                 \
+  FIELD(int, window_samples, 10000, range::between(1, kMaxCount),                                                 \
+        "gyro bias running mean over at most this many samples")                                                  \
+  FIELD(int, prior_samples, 100, range::non_negative_up_to(kMaxCount),                                            \
+        "weight of the initial gyro bias in the mean, in samples")
+
+// ---- fusion.units: IMUs reporting in g or deg/s -------------------------------------------------
+#define FARLIO_FUSION_UNITS_FIELDS(FIELD)                                                                           \
+  FIELD(bool, accel_detection, true, range::unchecked(), "detect an accelerometer reporting in g and scale it")     \
+  FIELD(int, accel_samples, 50, range::between(1, kMaxCount),                                                       \
+        "the mean |accel| of these first samples decides the unit")                                                 \
+  FIELD(bool, gyro_detection, true, range::unchecked(),                                                             \
+        "detect a gyro reporting in deg/s (its rotation ~57x the LiDAR's) and scale it; a gyro that stays "         \
+        "constant while the LiDAR turns is not used")                                                               \
+  FIELD(double, gyro_min_rotation_rad, 0.1, range::positive_up_to(kMaxSiValue),                                     \
+        "the gyro unit is decided once the gyro's or the LiDAR's rotation over the scans reaches this; until then " \
         "a scan during which the gyro turns is registered without the fusion's guess")
 
 // ---- cuda: the CUDA backend's device buffers, allocated once when the pipeline starts ----------
@@ -336,8 +361,37 @@ struct ThresholdConfig {
 struct RegistrationConfig {
   FARLIO_REGISTRATION_FIELDS(FARLIO_CONFIG_MEMBER)
 };
+struct FusionInitConfig {
+  FARLIO_FUSION_INIT_FIELDS(FARLIO_CONFIG_MEMBER)
+};
+struct FusionBiasConfig {
+  FARLIO_FUSION_BIAS_FIELDS(FARLIO_CONFIG_MEMBER)
+};
+struct FusionImuGateConfig {
+  FARLIO_FUSION_IMU_GATE_FIELDS(FARLIO_CONFIG_MEMBER)
+};
+struct FusionReferenceAnglesConfig {
+  FARLIO_FUSION_REFERENCE_ANGLES_FIELDS(FARLIO_CONFIG_MEMBER)
+};
+struct FusionDelayConfig {
+  FARLIO_FUSION_DELAY_FIELDS(FARLIO_CONFIG_MEMBER)
+};
+struct FusionStandstillConfig {
+  FARLIO_FUSION_STANDSTILL_FIELDS(FARLIO_CONFIG_MEMBER)
+};
+struct FusionUnitsConfig {
+  FARLIO_FUSION_UNITS_FIELDS(FARLIO_CONFIG_MEMBER)
+};
+/// The filter's own fields, then its parts: dotted names fusion.<field> and fusion.<part>.<field>.
 struct FusionConfig {
   FARLIO_FUSION_FIELDS(FARLIO_CONFIG_MEMBER)
+  FusionInitConfig init;
+  FusionBiasConfig bias;
+  FusionImuGateConfig imu_gate;
+  FusionReferenceAnglesConfig reference_angles;
+  FusionDelayConfig delay;
+  FusionStandstillConfig standstill;
+  FusionUnitsConfig units;
 };
 struct LocalizationConfig {
   FARLIO_LOCALIZATION_FIELDS(FARLIO_CONFIG_MEMBER)

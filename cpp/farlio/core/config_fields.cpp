@@ -5,6 +5,8 @@
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+#include <string_view>
+#include <utility>
 
 namespace farlio {
 namespace {
@@ -23,14 +25,83 @@ FARLIO_SECTION_FIELDS(VoxelMapConfig, FARLIO_MAP_FIELDS)
 FARLIO_SECTION_FIELDS(AdaptiveDensityConfig, FARLIO_DENSITY_FIELDS)
 FARLIO_SECTION_FIELDS(ThresholdConfig, FARLIO_THRESHOLD_FIELDS)
 FARLIO_SECTION_FIELDS(RegistrationConfig, FARLIO_REGISTRATION_FIELDS)
-FARLIO_SECTION_FIELDS(FusionConfig, FARLIO_FUSION_FIELDS)
+FARLIO_SECTION_FIELDS(FusionInitConfig, FARLIO_FUSION_INIT_FIELDS)
+FARLIO_SECTION_FIELDS(FusionBiasConfig, FARLIO_FUSION_BIAS_FIELDS)
+FARLIO_SECTION_FIELDS(FusionImuGateConfig, FARLIO_FUSION_IMU_GATE_FIELDS)
+FARLIO_SECTION_FIELDS(FusionReferenceAnglesConfig, FARLIO_FUSION_REFERENCE_ANGLES_FIELDS)
+FARLIO_SECTION_FIELDS(FusionDelayConfig, FARLIO_FUSION_DELAY_FIELDS)
+FARLIO_SECTION_FIELDS(FusionStandstillConfig, FARLIO_FUSION_STANDSTILL_FIELDS)
+FARLIO_SECTION_FIELDS(FusionUnitsConfig, FARLIO_FUSION_UNITS_FIELDS)
 FARLIO_SECTION_FIELDS(LocalizationConfig, FARLIO_LOCALIZATION_FIELDS)
 FARLIO_SECTION_FIELDS(LoopClosureConfig, FARLIO_LOOP_FIELDS)
 FARLIO_SECTION_FIELDS(CudaConfig, FARLIO_CUDA_FIELDS)
 FARLIO_SECTION_FIELDS(Config, FARLIO_TOP_FIELDS)
 
+/// The filter's own fields, then those of its parts one level deeper ("fusion.init.window_s").
+void append_fields(std::vector<ConfigField>& out, FusionConfig& section, const std::string& prefix) {
+  FARLIO_FUSION_FIELDS(FARLIO_FIELD_ENTRY)
+  append_fields(out, section.init, prefix + "init.");
+  append_fields(out, section.bias, prefix + "bias.");
+  append_fields(out, section.imu_gate, prefix + "imu_gate.");
+  append_fields(out, section.reference_angles, prefix + "reference_angles.");
+  append_fields(out, section.delay, prefix + "delay.");
+  append_fields(out, section.standstill, prefix + "standstill.");
+  append_fields(out, section.units, prefix + "units.");
+}
+
 #undef FARLIO_SECTION_FIELDS
 #undef FARLIO_FIELD_ENTRY
+
+/// Fields that moved into a sub-section: an old name is unknown, and its error names the new one.
+const std::vector<std::pair<std::string_view, std::string_view>> kRenamedFields = {
+    {"fusion.initial_position_std_m", "fusion.init.position_std_m"},
+    {"fusion.initial_attitude_std_rad", "fusion.init.attitude_std_rad"},
+    {"fusion.init_window_s", "fusion.init.window_s"},
+    {"fusion.estimate_imu_bias", "fusion.bias.estimate"},
+    {"fusion.gyro_bias_std_rad_s", "fusion.bias.gyro_std_rad_s"},
+    {"fusion.accel_bias_std_m_s2", "fusion.bias.accel_std_m_s2"},
+    {"fusion.gyro_bias_walk_rad_s2_sqrt_hz", "fusion.bias.gyro_walk_rad_s2_sqrt_hz"},
+    {"fusion.accel_bias_walk_m_s3_sqrt_hz", "fusion.bias.accel_walk_m_s3_sqrt_hz"},
+    {"fusion.gyro_bias_init_x_rad_s", "fusion.bias.gyro_init_x_rad_s"},
+    {"fusion.gyro_bias_init_y_rad_s", "fusion.bias.gyro_init_y_rad_s"},
+    {"fusion.gyro_bias_init_z_rad_s", "fusion.bias.gyro_init_z_rad_s"},
+    {"fusion.accel_bias_x_m_s2", "fusion.bias.accel_init_x_m_s2"},
+    {"fusion.accel_bias_y_m_s2", "fusion.bias.accel_init_y_m_s2"},
+    {"fusion.accel_bias_z_m_s2", "fusion.bias.accel_init_z_m_s2"},
+    {"fusion.imu_gap_limit_s", "fusion.imu_gate.gap_limit_s"},
+    {"fusion.max_bridged_gap_s", "fusion.imu_gate.max_bridged_gap_s"},
+    {"fusion.imu_max_accel_m_s2", "fusion.imu_gate.max_accel_m_s2"},
+    {"fusion.imu_max_gyro_rad_s", "fusion.imu_gate.max_gyro_rad_s"},
+    {"fusion.imu_spike_accel_m_s2", "fusion.imu_gate.spike_accel_m_s2"},
+    {"fusion.imu_spike_gyro_rad_s", "fusion.imu_gate.spike_gyro_rad_s"},
+    {"fusion.imu_spike_window_samples", "fusion.imu_gate.spike_window_samples"},
+    {"fusion.reference_angles", "fusion.reference_angles.enabled"},
+    {"fusion.reference_roll_std_rad", "fusion.reference_angles.roll_std_rad"},
+    {"fusion.reference_pitch_std_rad", "fusion.reference_angles.pitch_std_rad"},
+    {"fusion.reference_filter_taps", "fusion.reference_angles.filter_taps"},
+    {"fusion.reference_max_sin", "fusion.reference_angles.max_sin"},
+    {"fusion.delay_compensation", "fusion.delay.compensation"},
+    {"fusion.update_spread_steps", "fusion.delay.spread_steps"},
+    {"fusion.max_update_spread_steps", "fusion.delay.max_spread_steps"},
+    {"fusion.standstill_bias", "fusion.standstill.gyro_bias"},
+    {"fusion.standstill_max_speed_m_s", "fusion.standstill.max_speed_m_s"},
+    {"fusion.standstill_max_gyro_rad_s", "fusion.standstill.max_gyro_rad_s"},
+    {"fusion.standstill_max_accel_deviation_m_s2", "fusion.standstill.max_accel_deviation_m_s2"},
+    {"fusion.bias_window_samples", "fusion.standstill.window_samples"},
+    {"fusion.bias_prior_samples", "fusion.standstill.prior_samples"},
+    {"fusion.accel_unit_detection", "fusion.units.accel_detection"},
+    {"fusion.accel_unit_detection_samples", "fusion.units.accel_samples"},
+    {"fusion.gyro_unit_detection", "fusion.units.gyro_detection"},
+    {"fusion.gyro_unit_min_rotation_rad", "fusion.units.gyro_min_rotation_rad"},
+};
+
+/// " (renamed to NEW)" when `name` is the old name of a field, else "".
+std::string renamed_note(const std::string& name) {
+  for (const auto& [old_name, new_name] : kRenamedFields) {
+    if (old_name == name) return " (renamed to " + std::string(new_name) + ")";
+  }
+  return "";
+}
 
 /// The fields of one section, named under `prefix` ("map" gives "map.voxel_size_m").
 template <typename Section>
@@ -64,7 +135,7 @@ ConfigField find_field(Config& c, const std::string& name) {
     return edit_distance(a.name, name) < edit_distance(b.name, name);
   });
   constexpr std::size_t kSuggestions = 3;
-  std::string msg = "unknown config field '" + name + "'; closest:";
+  std::string msg = "unknown config field '" + name + "'" + renamed_note(name) + "; closest:";
   for (std::size_t i = 0; i < std::min(kSuggestions, fields.size()); ++i) msg += " " + fields[i].name;
   throw std::invalid_argument(msg);
 }
@@ -120,6 +191,8 @@ void check_ranges(const Section& section, const std::string& prefix) {
 }
 
 }  // namespace
+
+const std::vector<std::pair<std::string_view, std::string_view>>& renamed_config_fields() { return kRenamedFields; }
 
 bool FieldRange::contains(double v) const {
   if (!checked) return true;
@@ -209,17 +282,17 @@ void validate_config(const VoxelMapConfig& map, const std::string& prefix) {
 
 void validate_config(const FusionConfig& fusion) {
   check_ranges(fusion, "fusion");
-  require(fusion.reference_filter_taps % 2 == 1,
-          "fusion.reference_filter_taps must be odd, got " + number_text(fusion.reference_filter_taps));
+  require(fusion.reference_angles.filter_taps % 2 == 1,
+          "fusion.reference_angles.filter_taps must be odd, got " + number_text(fusion.reference_angles.filter_taps));
   require(fusion.history_s >= fusion.step_s, "fusion.history_s (" + number_text(fusion.history_s) +
                                                  ") must hold at least one fusion.step_s (" +
                                                  number_text(fusion.step_s) + ")");
-  require(fusion.imu_gap_limit_s <= fusion.max_bridged_gap_s,
-          "fusion.imu_gap_limit_s (" + number_text(fusion.imu_gap_limit_s) +
-              ") must not exceed fusion.max_bridged_gap_s (" + number_text(fusion.max_bridged_gap_s) +
+  require(fusion.imu_gate.gap_limit_s <= fusion.imu_gate.max_bridged_gap_s,
+          "fusion.imu_gate.gap_limit_s (" + number_text(fusion.imu_gate.gap_limit_s) +
+              ") must not exceed fusion.imu_gate.max_bridged_gap_s (" + number_text(fusion.imu_gate.max_bridged_gap_s) +
               "): a gap the fusion holds its input across must be bridged");
-  require(fusion.init_window_s < fusion.history_s,
-          "fusion.init_window_s (" + number_text(fusion.init_window_s) + ") must be below fusion.history_s (" +
+  require(fusion.init.window_s < fusion.history_s,
+          "fusion.init.window_s (" + number_text(fusion.init.window_s) + ") must be below fusion.history_s (" +
               number_text(fusion.history_s) + "): the initialisation reads the IMU of its window from that history");
 }
 

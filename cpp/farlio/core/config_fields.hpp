@@ -5,6 +5,8 @@
 // parameter set, and where it is validated.
 #include <cstdint>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -25,6 +27,10 @@ using ConfigValue = std::variant<double, int, std::int64_t, bool, Device>;
 
 /// The fields of `config` (pointers into it), in the order of config.hpp.
 std::vector<ConfigField> config_fields(Config& config);
+
+/// {old dotted name, new dotted name} of the fields that moved into a sub-section: an old name is
+/// an unknown field whose error names the new one.
+const std::vector<std::pair<std::string_view, std::string_view>>& renamed_config_fields();
 
 /// Sets a field from its text form; throws std::invalid_argument naming the field (and the
 /// closest known names) when it is unknown, the value does not parse or is out of its range.

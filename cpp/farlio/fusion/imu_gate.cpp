@@ -29,11 +29,11 @@ std::string describe(const char* what, const Eigen::Vector3d& v, const char* uni
 }  // namespace
 
 ImuGate::ImuGate(const FusionConfig& config)
-    : max_accel_m_s2_(config.imu_max_accel_m_s2),
-      max_gyro_rad_s_(config.imu_max_gyro_rad_s),
-      spike_accel_m_s2_(config.imu_spike_accel_m_s2),
-      spike_gyro_rad_s_(config.imu_spike_gyro_rad_s),
-      window_(static_cast<std::size_t>(std::max(0, config.imu_spike_window_samples))) {}
+    : max_accel_m_s2_(config.imu_gate.max_accel_m_s2),
+      max_gyro_rad_s_(config.imu_gate.max_gyro_rad_s),
+      spike_accel_m_s2_(config.imu_gate.spike_accel_m_s2),
+      spike_gyro_rad_s_(config.imu_gate.spike_gyro_rad_s),
+      window_(static_cast<std::size_t>(std::max(0, config.imu_gate.spike_window_samples))) {}
 
 std::string ImuGate::check(const ImuSample& sample, double accel_scale) {
   ImuSample si = sample;
@@ -42,10 +42,10 @@ std::string ImuGate::check(const ImuSample& sample, double accel_scale) {
     return describe("non-finite reading: accel", sample.accel_m_s2, "") + describe(", gyro", sample.gyro_rad_s, "");
   }
   if (si.accel_m_s2.norm() > max_accel_m_s2_) {
-    return describe("accelerometer", si.accel_m_s2, "m/s^2") + " is over fusion.imu_max_accel_m_s2";
+    return describe("accelerometer", si.accel_m_s2, "m/s^2") + " is over fusion.imu_gate.max_accel_m_s2";
   }
   if (si.gyro_rad_s.norm() > max_gyro_rad_s_) {
-    return describe("gyro", si.gyro_rad_s, "rad/s") + " is over fusion.imu_max_gyro_rad_s";
+    return describe("gyro", si.gyro_rad_s, "rad/s") + " is over fusion.imu_gate.max_gyro_rad_s";
   }
   std::string why;
   if (window_ > 0 && recent_.size() >= window_) {
@@ -53,10 +53,10 @@ std::string ImuGate::check(const ImuSample& sample, double accel_scale) {
     const Eigen::Vector3d dw = (si.gyro_rad_s - median(recent_, &ImuSample::gyro_rad_s)).cwiseAbs();
     if (da.maxCoeff() > spike_accel_m_s2_) {
       why = describe("accelerometer spike", si.accel_m_s2, "m/s^2") + ": off the recent median by more than " +
-            "fusion.imu_spike_accel_m_s2";
+            "fusion.imu_gate.spike_accel_m_s2";
     } else if (dw.maxCoeff() > spike_gyro_rad_s_) {
       why = describe("gyro spike", si.gyro_rad_s, "rad/s") + ": off the recent median by more than " +
-            "fusion.imu_spike_gyro_rad_s";
+            "fusion.imu_gate.spike_gyro_rad_s";
     }
   }
   if (window_ > 0) {

@@ -3,11 +3,12 @@
 // giving 1e30 m/s^2, a 1e4 m/s^2 spike, a 30 rad/s gyro glitch) integrated over one step moves
 // the state by metres or degrees, so a sample is rejected when it is
 //   - not finite,
-//   - physically impossible: |a| over imu_max_accel_m_s2 or |w| over imu_max_gyro_rad_s (the
-//     full scale of automotive and tactical MEMS parts is 16 g and 2000 deg/s),
-//   - a spike: one axis further than imu_spike_accel_m_s2 / imu_spike_gyro_rad_s from the median
-//     of the last imu_spike_window_samples samples received (rejected ones included, so a real
-//     step in the signal is accepted once it has lasted half the window).
+//   - physically impossible: |a| over max_accel_m_s2 or |w| over max_gyro_rad_s (the full scale
+//     of automotive and tactical MEMS parts is 16 g and 2000 deg/s),
+//   - a spike: one axis further than spike_accel_m_s2 / spike_gyro_rad_s from the median of the
+//     last spike_window_samples samples received (rejected ones included, so a real step in the
+//     signal is accepted once it has lasted half the window),
+// all of them fields of fusion.imu_gate.
 // A rejected sample is left out; the buffer interpolates across it (imu_buffer.hpp).
 #include <Eigen/Core>
 #include <deque>

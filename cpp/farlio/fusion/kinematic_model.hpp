@@ -11,7 +11,7 @@
 // The world frame of the filter is level up to its tilt: gravity in it is turned by the tilt
 // about its x and y axes. The frame is levelled when the filter starts (initialization.hpp): at
 // rest by the mean specific force, off by the accelerometer's bias (the tilt's initial std is
-// fusion.accel_bias_std_m_s2 / g); in motion by a short LiDAR-inertial alignment, off by a few
+// fusion.bias.accel_std_m_s2 / g); in motion by a short LiDAR-inertial alignment, off by a few
 // degrees. The tilt state lets the filter refine it as the vehicle turns (a tilt is fixed in the
 // world, an accelerometer bias in the body). The paper's filter has neither biases nor tilt; with
 // zero bias covariance and walk and a zero tilt covariance the two are the same filter.

@@ -23,7 +23,7 @@ constexpr double kRestPositionJitter_m = 0.02;
 /// follows from the specific force as in levelling.
 constexpr double kRestVelocityStd_m_s = 0.01;
 /// The std of the world frame's tilt after an initialisation in motion (rad): the alignment's
-/// error over init_window_s, which the tilt state then refines.
+/// error over fusion.init.window_s, which the tilt state then refines.
 constexpr double kInMotionTiltStd_rad = 0.05;
 /// A window whose free gravity estimate is further than this (relative) from the known
 /// magnitude does not initialise the filter: its poses or IMU disagree (a failing registration).
@@ -41,9 +41,9 @@ InputVector input_variance(const FusionConfig& c) {
 /// Per second: the bias random walks, zero unless the biases are estimated.
 InputVector bias_walk_variance(const FusionConfig& c) {
   InputVector q = InputVector::Zero();
-  if (c.estimate_imu_bias) {
-    q << Eigen::Vector3d::Constant(square(c.accel_bias_walk_m_s3_sqrt_hz)),
-        Eigen::Vector3d::Constant(square(c.gyro_bias_walk_rad_s2_sqrt_hz));
+  if (c.bias.estimate) {
+    q << Eigen::Vector3d::Constant(square(c.bias.accel_walk_m_s3_sqrt_hz)),
+        Eigen::Vector3d::Constant(square(c.bias.gyro_walk_rad_s2_sqrt_hz));
   }
   return q;
 }
@@ -64,14 +64,14 @@ SensorFusion::SensorFusion(const FusionConfig& config, double gravity_m_s2, MapF
       gravity_m_s2_(gravity_m_s2),
       step_ns_(seconds_to_ns(config.step_s)),
       ekf_(gravity_m_s2, input_variance(config), bias_walk_variance(config)),
-      imu_(config.imu_gap_limit_s, config.history_s),
+      imu_(config.imu_gate.gap_limit_s, config.history_s),
       imu_gate_(config),
-      accel_unit_(config.accel_unit_detection, config.accel_unit_detection_samples, gravity_m_s2),
+      accel_unit_(config.units.accel_detection, config.units.accel_samples, gravity_m_s2),
       bias_(config, gravity_m_s2),
-      reference_(config.reference_filter_taps, gravity_m_s2, config.reference_max_sin),
+      reference_(config.reference_angles.filter_taps, gravity_m_s2, config.reference_angles.max_sin),
       history_(static_cast<std::size_t>(std::ceil(config.history_s / config.step_s)) + kExtraHistoryEntries),
-      queue_(config.delay_compensation),
-      accel_bias_m_s2_(config.accel_bias_x_m_s2, config.accel_bias_y_m_s2, config.accel_bias_z_m_s2),
+      queue_(config.delay.compensation),
+      accel_bias_m_s2_(config.bias.accel_init_x_m_s2, config.bias.accel_init_y_m_s2, config.bias.accel_init_z_m_s2),
       window_(std::move(known.window)),
       known_tilt_std_rad_(known.tilt_std_rad) {
   if (known.gravity_map_m_s2) level_from_map_ = level_from_map(*known.gravity_map_m_s2);
@@ -117,7 +117,7 @@ void SensorFusion::add_imu(const ImuSample& sample) {
     return;
   }
   accel_unit_.add(sample.accel_m_s2);
-  if (config_.standstill_bias && initialized() && accel_unit_.decided()) {
+  if (config_.standstill.gyro_bias && initialized() && accel_unit_.decided()) {
     const double speed_m_s = ekf_.state().segment<3>(kVelocityIndex).norm();
     bias_.add(sample.gyro_rad_s, accel_unit_.scale() * sample.accel_m_s2, speed_m_s);
   }
@@ -159,7 +159,7 @@ void SensorFusion::step() {
   queue_.inject(ekf_);
   record_correction(before_injections);
   last_input_ = u1;
-  if (config_.reference_angles) fuse_reference_angles(t1);
+  if (config_.reference_angles.enabled) fuse_reference_angles(t1);
   history_.push(t1, ekf_.state(), cumulative_correction_);
   ++stats_.steps;
   imu_.discard_before(t1);
@@ -177,9 +177,10 @@ void SensorFusion::fuse_reference_angles(std::int64_t stamp_ns) {
   }
   const Eigen::Vector2d z(angles->roll_rad, angles->pitch_rad);
   const Eigen::Matrix2d R =
-      Eigen::Vector2d(square(config_.reference_roll_std_rad), square(config_.reference_pitch_std_rad)).asDiagonal();
+      Eigen::Vector2d(square(config_.reference_angles.roll_std_rad), square(config_.reference_angles.pitch_std_rad))
+          .asDiagonal();
   const ArrivalResidual r = arrival_residual(MeasurementKind::kRollPitch, z, angles->stamp_ns, history_, x,
-                                             cumulative_correction_, config_.delay_compensation);
+                                             cumulative_correction_, config_.delay.compensation);
   if (!r.residual) return;
   const StateVector before = x;
   if (ekf_.update(MeasurementKind::kRollPitch, *r.residual, R, gate(2))) {
@@ -203,12 +204,12 @@ void SensorFusion::initialize(std::int64_t stamp_ns, const SE3& level_pose, cons
   x.segment<3>(kAttitudeIndex) = euler_from_rotation(level_pose.rotation());
   x.segment<3>(kVelocityIndex) = velocity_body_m_s;
   StateVector variance = StateVector::Zero();
-  variance.segment<3>(kPositionIndex).setConstant(square(config_.initial_position_std_m));
-  variance.segment<3>(kAttitudeIndex).setConstant(square(config_.initial_attitude_std_rad));
+  variance.segment<3>(kPositionIndex).setConstant(square(config_.init.position_std_m));
+  variance.segment<3>(kAttitudeIndex).setConstant(square(config_.init.attitude_std_rad));
   variance.segment<3>(kVelocityIndex).setConstant(square(velocity_std_m_s));
-  if (config_.estimate_imu_bias) {
-    variance.segment<3>(kGyroBiasIndex).setConstant(square(config_.gyro_bias_std_rad_s));
-    variance.segment<3>(kAccelBiasIndex).setConstant(square(config_.accel_bias_std_m_s2));
+  if (config_.bias.estimate) {
+    variance.segment<3>(kGyroBiasIndex).setConstant(square(config_.bias.gyro_std_rad_s));
+    variance.segment<3>(kAccelBiasIndex).setConstant(square(config_.bias.accel_std_m_s2));
   }
   variance.segment<2>(kTiltIndex).setConstant(square(tilt_std_rad));
   StateMatrix P = variance.asDiagonal();
@@ -260,10 +261,10 @@ SE3 SensorFusion::to_map(const SE3& level_pose) const {
 void SensorFusion::add_to_window(std::int64_t stamp_ns, const SE3& body_pose) {
   if (!window_.empty() && stamp_ns <= window_.back().stamp_ns) return;
   const auto span_s = [&](const WindowPose& from) { return ns_to_seconds(stamp_ns - from.stamp_ns); };
-  if (!window_.empty() && span_s(window_.back()) > config_.init_window_s) window_.clear();  // an outage
+  if (!window_.empty() && span_s(window_.back()) > config_.init.window_s) window_.clear();  // an outage
   window_.push_back({stamp_ns, body_pose});
-  // the shortest run of the newest results that spans init_window_s
-  while (window_.size() > 2 && span_s(window_[1]) >= config_.init_window_s) window_.erase(window_.begin());
+  // the shortest run of the newest results that spans fusion.init.window_s
+  while (window_.size() > 2 && span_s(window_[1]) >= config_.init.window_s) window_.erase(window_.begin());
 }
 
 std::optional<ImuMean> SensorFusion::imu_mean(std::int64_t start_ns, std::int64_t end_ns) const {
@@ -287,8 +288,8 @@ bool SensorFusion::window_at_rest() const {
   for (std::size_t k = 1; k < window_.size(); ++k) {
     const double dt_s = ns_to_seconds(window_[k].stamp_ns - window_[k - 1].stamp_ns);
     const SE3 motion = window_[k - 1].body_pose.inverse() * window_[k].body_pose;
-    if (motion.translation().norm() > std::max(config_.standstill_max_speed_m_s * dt_s, kRestPositionJitter_m) ||
-        motion.angle_rad() > config_.standstill_max_gyro_rad_s * dt_s)
+    if (motion.translation().norm() > std::max(config_.standstill.max_speed_m_s * dt_s, kRestPositionJitter_m) ||
+        motion.angle_rad() > config_.standstill.max_gyro_rad_s * dt_s)
       return false;
   }
   return window_.size() >= 2;
@@ -305,7 +306,7 @@ bool SensorFusion::initialize_from_window() {
   const double span_s = ns_to_seconds(window_.back().stamp_ns - window_.front().stamp_ns);
   if (at_rest) {  // gravity is the mean specific force, the velocity zero: two results suffice
     options.zero_velocity_std_m_s = kRestVelocityStd_m_s;
-  } else if (!level_from_map_ && (window_.size() < kMinPosesInMotion || span_s < config_.init_window_s)) {
+  } else if (!level_from_map_ && (window_.size() < kMinPosesInMotion || span_s < config_.init.window_s)) {
     return false;  // in motion, gravity is found over the whole window
   }
   const auto alignment = align_window(
@@ -320,7 +321,7 @@ bool SensorFusion::initialize_from_window() {
   const Eigen::Vector3d velocity_body = last.body_pose.rotation().transpose() * alignment->velocity_map_m_s;
   // levelled at rest, gravity is off by the accelerometer's bias (held, as the paper's 9-state
   // filter holds its level, when the biases are not estimated); in motion, by the alignment's error
-  const double levelled_tilt_std_rad = config_.estimate_imu_bias ? config_.accel_bias_std_m_s2 / gravity_m_s2_ : 0.0;
+  const double levelled_tilt_std_rad = config_.bias.estimate ? config_.bias.accel_std_m_s2 / gravity_m_s2_ : 0.0;
   const double tilt_std_rad = first ? (at_rest ? levelled_tilt_std_rad : kInMotionTiltStd_rad) : known_tilt_std_rad_;
   initialize(last.stamp_ns, to_level(last.body_pose), velocity_body, config_.lidar_velocity_std_m_s, tilt_std_rad);
   InitializationReport& report = stats_.initialization;
@@ -339,10 +340,10 @@ bool SensorFusion::initialize_from_window() {
 }
 
 int SensorFusion::spread_steps(std::int64_t measured_at_ns) const {
-  if (config_.update_spread_steps > 0) return config_.update_spread_steps;
+  if (config_.delay.spread_steps > 0) return config_.delay.spread_steps;
   if (!last_lidar_ns_ || measured_at_ns <= *last_lidar_ns_) return 1;
   const auto n = std::llround(static_cast<double>(measured_at_ns - *last_lidar_ns_) / static_cast<double>(step_ns_));
-  return static_cast<int>(std::clamp<long long>(n, 1, std::max(1, config_.max_update_spread_steps)));
+  return static_cast<int>(std::clamp<long long>(n, 1, std::max(1, config_.delay.max_spread_steps)));
 }
 
 LidarUpdateResult SensorFusion::add_lidar(std::int64_t measured_at_ns, const SE3& map_pose,
@@ -381,7 +382,7 @@ LidarUpdateResult SensorFusion::add_lidar(std::int64_t measured_at_ns, const SE3
   std::vector<Eigen::VectorXd> residuals;
   for (const LidarGroup& g : groups) {
     ArrivalResidual r = arrival_residual(g.kind, g.z, measured_at_ns, history_, x_now, cumulative_correction_,
-                                         config_.delay_compensation);
+                                         config_.delay.compensation);
     if (!r.residual) {
       ++stats_.lidar_too_old;
       result.rejection_reason = r.rejection_reason;
@@ -412,7 +413,7 @@ LidarUpdateResult SensorFusion::add_lidar(std::int64_t measured_at_ns, const SE3
   if (consecutive_rejections_ >= std::max(1, config_.max_consecutive_rejections)) {
     ++stats_.reinitializations;
     warn("LiDAR positions rejected " + std::to_string(consecutive_rejections_) +
-         " times in a row: re-initialising from the LiDAR results of the last fusion.init_window_s");
+         " times in a row: re-initialising from the LiDAR results of the last fusion.init.window_s");
     if (!initialize_from_window()) {  // the window too short (an outage): the eq. (6) velocity
       const Eigen::Vector3d velocity =
           use_velocity ? body_velocity_m_s : Eigen::Vector3d(ekf_.state().segment<3>(kVelocityIndex));

@@ -6,7 +6,7 @@
 // Poses in and out are in the map frame of the scan pipeline, which need not be level (it is
 // fixed at the first scan, while the body may already move). The filter is initialised from the
 // LiDAR results of its first scans and the IMU between them (initialization.hpp): at rest as soon
-// as two results show it, in motion once they span fusion.init_window_s; that alignment finds
+// as two results show it, in motion once they span fusion.init.window_s; that alignment finds
 // gravity in the map frame, and the EKF runs in the level frame it gives (z up), so that its
 // gravity and reference angles hold. A re-initialisation after rejected results takes the
 // velocity from the LiDAR results of the same window, with gravity already known.
@@ -121,13 +121,14 @@ class SensorFusion {
   [[nodiscard]] FusionStats stats() const;
 
  private:
-  /// Adds a LiDAR result to the initialisation window (the last init_window_s of results; a gap
+  /// Adds a LiDAR result to the initialisation window (the last fusion.init.window_s of results; a gap
   /// longer than that starts it again).
   void add_to_window(std::int64_t stamp_ns, const SE3& body_pose);
   /// Initialises the filter from the window when its results allow (initialization.hpp); true if it did.
   bool initialize_from_window();
   /// Whether the window's results show the body at rest (between every two, a displacement within
-  /// standstill_max_speed_m_s or the LiDAR's jitter, and a rotation within standstill_max_gyro_rad_s).
+  /// fusion.standstill.max_speed_m_s or the LiDAR's jitter, and a rotation within
+  /// fusion.standstill.max_gyro_rad_s).
   [[nodiscard]] bool window_at_rest() const;
   /// The mean IMU input over [start_ns, end_ns] with the biases removed, for the alignment.
   [[nodiscard]] std::optional<ImuMean> imu_mean(std::int64_t start_ns, std::int64_t end_ns) const;

@@ -6,12 +6,12 @@
 namespace farlio::fusion {
 
 StandstillGyroBias::StandstillGyroBias(const FusionConfig& c, double gravity_m_s2)
-    : initial_bias_rad_s_(c.gyro_bias_init_x_rad_s, c.gyro_bias_init_y_rad_s, c.gyro_bias_init_z_rad_s),
-      prior_weight_(std::max(0, c.bias_prior_samples)),
-      max_samples_(static_cast<std::size_t>(std::max(1, c.bias_window_samples))),
-      max_speed_m_s_(c.standstill_max_speed_m_s),
-      max_gyro_rad_s_(c.standstill_max_gyro_rad_s),
-      max_accel_deviation_m_s2_(c.standstill_max_accel_deviation_m_s2),
+    : initial_bias_rad_s_(c.bias.gyro_init_x_rad_s, c.bias.gyro_init_y_rad_s, c.bias.gyro_init_z_rad_s),
+      prior_weight_(std::max(0, c.standstill.prior_samples)),
+      max_samples_(static_cast<std::size_t>(std::max(1, c.standstill.window_samples))),
+      max_speed_m_s_(c.standstill.max_speed_m_s),
+      max_gyro_rad_s_(c.standstill.max_gyro_rad_s),
+      max_accel_deviation_m_s2_(c.standstill.max_accel_deviation_m_s2),
       gravity_m_s2_(gravity_m_s2) {}
 
 bool StandstillGyroBias::add(const Eigen::Vector3d& gyro_rad_s, const Eigen::Vector3d& accel_m_s2, double speed_m_s) {

@@ -84,10 +84,10 @@ FusionDriver::FusionDriver(const Config& config, double gravity_m_s2, const SE3&
     : registration_config_(validated(config).registration),
       fusion_config_(config.fusion),
       gravity_m_s2_(gravity_m_s2),
-      max_bridged_gap_ns_(seconds_to_ns(config.fusion.max_bridged_gap_s)),
+      max_bridged_gap_ns_(seconds_to_ns(config.fusion.imu_gate.max_bridged_gap_s)),
       T_imu_lidar_(T_imu_lidar),
-      gyro_unit_(config.fusion.gyro_unit_detection, config.fusion.gyro_unit_min_rotation_rad,
-                 config.fusion.standstill_max_gyro_rad_s) {
+      gyro_unit_(config.fusion.units.gyro_detection, config.fusion.units.gyro_min_rotation_rad,
+                 config.fusion.standstill.max_gyro_rad_s) {
   validate_gravity(gravity_m_s2, "gravity_m_s2");
   if (inertial) fusion_.emplace(fusion_config_, gravity_m_s2_);
 }
@@ -143,9 +143,9 @@ bool FusionDriver::admit(const ImuSample& sample) {
     return false;
   }
   newest_imu_ns_ = sample.stamp_ns;
-  if (first_accels_.size() < static_cast<std::size_t>(fusion_config_.accel_unit_detection_samples)) {
+  if (first_accels_.size() < static_cast<std::size_t>(fusion_config_.units.accel_samples)) {
     first_accels_.push_back(sample.accel_m_s2);
-    if (first_accels_.size() == static_cast<std::size_t>(fusion_config_.accel_unit_detection_samples)) {
+    if (first_accels_.size() == static_cast<std::size_t>(fusion_config_.units.accel_samples)) {
       if (std::string silent = fusion::silent_accelerometer(first_accels_); !silent.empty()) {
         warn(std::move(silent));
         fusion_.reset();
@@ -159,7 +159,7 @@ bool FusionDriver::admit(const ImuSample& sample) {
 void FusionDriver::jump_clock(const ImuSample& sample) {
   warn("IMU stamp " + seconds_text(ns_to_seconds(sample.stamp_ns)) + " s jumps by " + seconds_text(jump_s(sample)) +
        " s from the newest (" + seconds_text(ns_to_seconds(*newest_imu_ns_)) +
-       " s), beyond fusion.max_bridged_gap_s (" + seconds_text(fusion_config_.max_bridged_gap_s) +
+       " s), beyond fusion.imu_gate.max_bridged_gap_s (" + seconds_text(fusion_config_.imu_gate.max_bridged_gap_s) +
        " s), and the samples after it follow it: the fusion is reset and starts again from the next LiDAR results");
   recent_imu_.clear();
   gyro_unit_.forget_samples();
@@ -170,13 +170,13 @@ void FusionDriver::jump_clock(const ImuSample& sample) {
 
 void FusionDriver::add_imu(const ImuSample& sample, Samples& out) {
   if (!fusion_) return;
-  // A sample beyond fusion.max_bridged_gap_s from the newest waits for the next one: when that
+  // A sample beyond fusion.imu_gate.max_bridged_gap_s from the newest waits for the next one: when that
   // follows it, the clock jumped (the fusion starts again there); when it follows the newest, the
   // held sample alone was stamped wrong and is dropped (one bad stamp costs one sample).
   if (held_jump_) {
     const ImuSample held = *std::exchange(held_jump_, std::nullopt);
     const double from_held_s = ns_to_seconds(sample.stamp_ns) - ns_to_seconds(held.stamp_ns);
-    if (from_held_s >= 0.0 && from_held_s <= fusion_config_.max_bridged_gap_s) {
+    if (from_held_s >= 0.0 && from_held_s <= fusion_config_.imu_gate.max_bridged_gap_s) {
       jump_clock(held);
       feed_imu(held, out);
     } else {
@@ -185,7 +185,7 @@ void FusionDriver::add_imu(const ImuSample& sample, Samples& out) {
     }
   }
   if (!fusion_) return;
-  if (std::abs(jump_s(sample)) > fusion_config_.max_bridged_gap_s) {
+  if (std::abs(jump_s(sample)) > fusion_config_.imu_gate.max_bridged_gap_s) {
     held_jump_ = sample;
     return;
   }
@@ -241,7 +241,7 @@ void FusionDriver::apply_gyro_unit() {
 SE3 FusionDriver::start_pose(std::int64_t first_scan_end_ns, const std::optional<SE3>& requested) const {
   if (!fusion_) return requested.value_or(SE3());
   const SE3 level =
-      gravity_aligned_start(startup_imu_, first_scan_end_ns, gravity_m_s2_, fusion_config_.standstill_max_gyro_rad_s);
+      gravity_aligned_start(startup_imu_, first_scan_end_ns, gravity_m_s2_, fusion_config_.standstill.max_gyro_rad_s);
   if (!requested) return level;
   Eigen::Vector3d rpy = fusion::euler_from_rotation(level.rotation());
   rpy.z() = fusion::euler_from_rotation(requested->rotation()).z();
@@ -318,7 +318,7 @@ void FusionDriver::compare_gyro_unit(std::int64_t stamp_ns, const OdometryFrame&
       ns_to_seconds(stamp_ns - *first_compared_ns_) > kUndecidedGyroWarning_s) {
     warn("the gyro's unit (rad/s or deg/s) is not decided after " + seconds_text(kUndecidedGyroWarning_s) +
          " s of scans: the LiDAR has hardly turned. Until it turns, a gyro in deg/s would turn the fused "
-         "orientation 57 times too far (fusion.gyro_unit_detection)");
+         "orientation 57 times too far (fusion.units.gyro_detection)");
     warned_undecided_gyro_ = true;
   }
 }
@@ -357,10 +357,10 @@ void FusionDriver::link(const Scan& scan, OdometryFrame& frame) {
   }
   compare_gyro_unit(stamp_ns, frame);
   if (frame.drop_reason.empty() && fusion_ && has_imu() && !fusion_->initialized() &&
-      ns_to_seconds(clock_ns_) - ns_to_seconds(stamp_ns) > fusion_config_.max_bridged_gap_s) {
+      ns_to_seconds(clock_ns_) - ns_to_seconds(stamp_ns) > fusion_config_.imu_gate.max_bridged_gap_s) {
     frame.drop_reason =
         "not fused: the scan ends " + seconds_text(ns_to_seconds(clock_ns_) - ns_to_seconds(stamp_ns)) +
-        " s before the IMU clock, beyond fusion.max_bridged_gap_s (do the IMU and LiDAR clocks differ?)";
+        " s before the IMU clock, beyond fusion.imu_gate.max_bridged_gap_s (do the IMU and LiDAR clocks differ?)";
   }
   hold_start_at_degenerate_scan(stamp_ns, frame);
   if (frame.drop_reason.empty() && fusion_ && has_imu()) {

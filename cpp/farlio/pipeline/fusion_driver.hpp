@@ -15,13 +15,13 @@
 // fused; the drop rules still apply.
 // What the driver does not let through (docs/hardening.md, "Configuration and clocks"), each with a
 // warning (take_warnings):
-//   a sample stamped more than fusion.max_bridged_gap_s from the newest (a far-future stamp, a
+//   a sample stamped more than fusion.imu_gate.max_bridged_gap_s from the newest (a far-future stamp, a
 //     stamp far back) waits for the next: if that one follows the newest, the stamp alone was
 //     wrong and the sample is dropped; if it follows the held one, the IMU clock jumped: the
 //     fusion is reset and starts again from the next LiDAR results, so that no catch-up loop runs
 //     across the jump; a sample older than the newest within the gap is dropped, and no odometry
 //     stamp is emitted twice;
-//   a LiDAR result older than the IMU clock by more than fusion.max_bridged_gap_s does not
+//   a LiDAR result older than the IMU clock by more than fusion.imu_gate.max_bridged_gap_s does not
 //     initialise the filter (the IMU and LiDAR clocks differ);
 //   a gyro in deg/s is scaled (the fusion starts again), a stuck gyro or a silent accelerometer
 //     ends the fusion (LiDAR-only): fusion/gyro_unit_detector.hpp; a unit still undecided after
@@ -89,14 +89,14 @@ class FusionDriver {
   void add_imu(const ImuSample& sample, Samples& out);
   /// Moves the fusion clock to stamp_ns without new IMU data, appending the odometry samples up
   /// to it (the replay, past the last sample it has fed); the fusion predicts at most
-  /// fusion.max_bridged_gap_s beyond the newest sample.
+  /// fusion.imu_gate.max_bridged_gap_s beyond the newest sample.
   void advance_to(std::int64_t stamp_ns, Samples& out);
   /// Runs LiDAR-only from now on.
   void stop_fusion() { fusion_.reset(); }
   /// The warnings since the last call (a reset of the fusion, the gyro's unit, an unusable IMU).
   [[nodiscard]] std::vector<std::string> take_warnings() { return std::exchange(warnings_, {}); }
-  /// fusion.max_bridged_gap_s: the largest jump of the IMU clock the fusion bridges.
-  [[nodiscard]] double max_bridged_gap_s() const { return fusion_config_.max_bridged_gap_s; }
+  /// fusion.imu_gate.max_bridged_gap_s: the largest jump of the IMU clock the fusion bridges.
+  [[nodiscard]] double max_bridged_gap_s() const { return fusion_config_.imu_gate.max_bridged_gap_s; }
 
   [[nodiscard]] bool inertial() const { return fusion_.has_value(); }
   /// Whether an IMU sample has been fed.

@@ -58,7 +58,7 @@ Odometry::Odometry(const Config& config, const SE3& T_imu_lidar, double gravity_
   validate_replay_options(options_);
   if (!driver_.inertial()) return;
   sort_by_stamp(imu_, warnings_);
-  if (std::string silent = fusion::silent_accelerometer(first_accels(imu_, config.fusion.accel_unit_detection_samples));
+  if (std::string silent = fusion::silent_accelerometer(first_accels(imu_, config.fusion.units.accel_samples));
       !silent.empty()) {
     warnings_.push_back(std::move(silent));
     driver_.stop_fusion();

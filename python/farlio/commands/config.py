@@ -52,17 +52,20 @@ def render(everything: bool = True) -> str:
         f"# farlio: {which}: dotted names, defaults, units in the names. Pass with --config FILE",
         "# or one at a time with --set name=value; a field left out keeps its default.",
     ]
-    section = None
+    opened: list[str] = []  # the sections (outermost first) the previous field was written in
     for name, default, doc, valid in fields:
         if not everything and name not in ESSENTIAL_FIELDS:
             continue
-        head, _, leaf = name.rpartition(".")
-        if head != section:
-            section = head
-            lines.append(f"{head}:" if head else "")
-        indent = "  " if head else ""
+        *sections, leaf = name.split(".")
+        shared = 0
+        while shared < min(len(opened), len(sections)) and opened[shared] == sections[shared]:
+            shared += 1
+        if not sections and opened:
+            lines.append("")  # the top-level fields after the last section
+        lines.extend(f"{'  ' * depth}{sections[depth]}:" for depth in range(shared, len(sections)))
+        opened = sections
         valid_text = f" [{valid}]" if valid else ""
-        lines.append(f"{indent}{leaf or name}: {_yaml_scalar(default)}  # {doc}{valid_text}")
+        lines.append(f"{'  ' * len(sections)}{leaf}: {_yaml_scalar(default)}  # {doc}{valid_text}")
     return "\n".join(lines) + "\n"
 
 
