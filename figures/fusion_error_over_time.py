@@ -32,9 +32,7 @@ def report(name: str, t: np.ndarray, diff: np.ndarray, axis: int, every_s: float
     rms = np.sqrt((diff**2).sum(axis=1).mean())
     per_axis = np.sqrt((diff**2).mean(axis=0))
     print(f"{name}: APE {rms:.4f} m; RMS per axis x y z {per_axis[0]:.4f} {per_axis[1]:.4f} {per_axis[2]:.4f} m")
-    seconds = [
-        np.sqrt((diff[(t >= s) & (t < s + 1)] ** 2).sum(axis=1).mean()) for s in range(int(t[-1]) + 1)
-    ]
+    seconds = [np.sqrt((diff[(t >= s) & (t < s + 1)] ** 2).sum(axis=1).mean()) for s in range(int(t[-1]) + 1)]
     print("  RMS per second (m): " + " ".join(f"{v:.3f}" for v in seconds))
     marks = np.arange(0.0, t[-1] + 1e-9, every_s)
     along = [diff[np.argmin(np.abs(t - m)), axis] for m in marks]
