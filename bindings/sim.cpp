@@ -111,6 +111,9 @@ void bind_sim_config(nb::module_& m) {
               "the LiDAR on the vehicle: the profile's own sensors (Profile) or one sensor of a named model")
       .def_rw("lidar_rate_hz", &SimConfig::lidar_rate_hz)
       .def_rw("imu_rate_hz", &SimConfig::imu_rate_hz)
+      .def_rw("imu_time_offset_s", &SimConfig::imu_time_offset_s,
+              "the IMU's samples fall this long after the whole IMU periods of the sequence clock (s, below "
+              "1 / imu_rate_hz)")
       .def_rw("gravity_m_s2", &SimConfig::gravity_m_s2);
   m.def("default_config", &default_config, "profile"_a, "The documented defaults of a profile.");
   m.def(

@@ -37,6 +37,7 @@ def make_config(
     lidar: str = "profile",
     lidar_rate_hz: float | None = None,
     imu_rate_hz: float | None = None,
+    imu_time_offset_s: float = 0.0,
     **noise: float,
 ) -> Any:
     """The profile's defaults with the given overrides: the IMU set to imu_grade (with the platform
@@ -44,7 +45,8 @@ def make_config(
     NoiseConfig name. motion_start_s > 0 begins the sequence that far into the profile's motion (a
     recording that starts while the body moves). lidar puts one sensor of a named model (LIDAR_MODELS)
     on the vehicle in place of the profile's own; lidar_rate_hz and imu_rate_hz replace the profile's
-    rates."""
+    rates; imu_time_offset_s puts the IMU's samples that long after the whole IMU periods of the
+    sequence clock (below one period: between the fusion's steps)."""
     cfg = _core.sim.default_config(profile)
     cfg.seed = seed
     if duration_s is not None:
@@ -56,6 +58,7 @@ def make_config(
         cfg.lidar_rate_hz = lidar_rate_hz
     if imu_rate_hz is not None:
         cfg.imu_rate_hz = imu_rate_hz
+    cfg.imu_time_offset_s = imu_time_offset_s
     cfg = _core.sim.apply_imu_grade(cfg, imu_grade, vibration)
     n = cfg.noise
     for name, value in noise.items():

@@ -125,6 +125,27 @@ TEST(SimImu, AtRestReadsGravityUp) {
   }
 }
 
+// imu_time_offset_s: the samples fall that long after the whole IMU periods (an IMU not phase-locked
+// to the LiDAR), each the reading of the motion at its own stamp; an offset of a period or more is
+// an error naming the field.
+TEST(SimImu, AnOffsetMovesTheSamplesBetweenThePeriods) {
+  SimConfig cfg = default_config(Profile::Urban);
+  cfg.noise_free = true;
+  cfg.duration_s = 2.0;
+  cfg.motion_start_s = 25.0;  // turning
+  cfg.imu_rate_hz = 10.0;
+  cfg.imu_time_offset_s = 0.04;
+  const SequenceGenerator gen(cfg);
+  const std::vector<ImuSample> imu = gen.imu();
+  ASSERT_EQ(imu.size(), 20u);  // 0.04, 0.14, ..., 1.94 s
+  for (std::size_t k = 0; k < imu.size(); ++k) {
+    EXPECT_EQ(imu[k].stamp_ns, cfg.start_stamp_ns + static_cast<std::int64_t>(k) * 100'000'000 + 40'000'000);
+    EXPECT_LT((imu[k].gyro_rad_s - gen.state(imu[k].stamp_ns).angular_velocity_body_rad_s).norm(), 1e-12);
+  }
+  cfg.imu_time_offset_s = 0.1;
+  EXPECT_THROW(SequenceGenerator{cfg}, std::invalid_argument);
+}
+
 TEST(SimImu, NoiseMatchesConfiguredStatistics) {
   SimConfig noisy = default_config(Profile::Racetrack);
   noisy.duration_s = 5.0;

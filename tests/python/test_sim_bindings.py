@@ -142,3 +142,17 @@ def test_simulate_cli_imu_grade_writes_the_error_model(tmp_path):
     assert float(meta["accel_scale_factor_std_ppm"]) == 1000.0 and int(meta["seed"]) == 2
     imu = np.loadtxt(out / "imu.csv", delimiter=",", skiprows=1, ndmin=2)
     assert imu.shape[0] == 51  # 0.25 s at 200 Hz, both ends
+
+
+def test_an_imu_offset_puts_the_samples_between_the_periods():
+    """imu_time_offset_s (farlio simulate --imu-offset): a 100 Hz IMU 5 ms off the sequence clock."""
+    from farlio.simulation import make_config
+
+    cfg = make_config("urban", duration_s=SHORT_DURATION_S, imu_time_offset_s=0.005)
+    gen = sim.SequenceGenerator(cfg)
+    stamps = np.array([s.stamp_ns for s in gen.imu()]) - cfg.start_stamp_ns
+    assert np.all(stamps % 10_000_000 == 5_000_000) and len(stamps) == 100
+    assert gen.description()["imu_time_offset_s"] == "0.005"
+    cfg.imu_time_offset_s = 0.01
+    with pytest.raises(ValueError, match="imu_time_offset_s"):
+        sim.SequenceGenerator(cfg)

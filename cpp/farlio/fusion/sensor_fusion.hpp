@@ -107,6 +107,8 @@ class SensorFusion {
   [[nodiscard]] const FusionConfig& config() const { return config_; }
   /// The filter step (FusionConfig::step_s) in ns.
   [[nodiscard]] std::int64_t step_ns() const { return step_ns_; }
+  /// The filter's time: its newest step (valid once initialised).
+  [[nodiscard]] std::int64_t time_ns() const { return time_ns_; }
   /// The current estimate, its pose in the map frame.
   [[nodiscard]] BodyEstimate estimate() const;
   /// The pose at stamp_ns as the filter now estimates it: the history's state plus the corrections

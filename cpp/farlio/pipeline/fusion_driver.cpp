@@ -162,6 +162,7 @@ void FusionDriver::jump_clock(const ImuSample& sample) {
        " s), beyond fusion.imu_gate.max_bridged_gap_s (" + seconds_text(fusion_config_.imu_gate.max_bridged_gap_s) +
        " s), and the samples after it follow it: the fusion is reset and starts again from the next LiDAR results");
   recent_imu_.clear();
+  pending_.clear();  // stamped on the old clock
   gyro_unit_.forget_samples();
   restart_fusion(recent_imu_, /*regrid=*/true);
   clock_ns_ = sample.stamp_ns;
@@ -206,20 +207,45 @@ void FusionDriver::feed_imu(const ImuSample& sample, Samples& out) {
   // the output grid: whole multiples of the step, the first after the first sample
   const std::int64_t step_ns = fusion_->step_ns();
   if (next_output_ns_ == 0) next_output_ns_ = (sample.stamp_ns / step_ns + 1) * step_ns;
-  while (next_output_ns_ < sample.stamp_ns) emit_step(out);  // instants before the sample: without it
   fusion_->add_imu(si);
   advance_to(sample.stamp_ns, out);
+}
+
+std::int64_t FusionDriver::fusion_horizon(std::int64_t stamp_ns) const {
+  if (!newest_imu_ns_ || stamp_ns <= *newest_imu_ns_) return stamp_ns;
+  const double ahead_s = ns_to_seconds(stamp_ns) - ns_to_seconds(*newest_imu_ns_);
+  if (ahead_s <= fusion_config_.imu_gate.gap_limit_s) return *newest_imu_ns_;  // the next sample is due
+  // a gap: the fusion predicts with its last input, at most the bridged gap beyond the newest sample
+  if (*newest_imu_ns_ >= std::numeric_limits<std::int64_t>::max() - max_bridged_gap_ns_) return stamp_ns;
+  return std::min(stamp_ns, *newest_imu_ns_ + max_bridged_gap_ns_);
 }
 
 void FusionDriver::advance_to(std::int64_t stamp_ns, Samples& out) {
   if (!fusion_) return;
   clock_ns_ = std::max(clock_ns_, stamp_ns);
-  // beyond the newest sample the fusion predicts with its last input: at most the bridged gap
-  if (newest_imu_ns_ && *newest_imu_ns_ < std::numeric_limits<std::int64_t>::max() - max_bridged_gap_ns_) {
-    stamp_ns = std::min(stamp_ns, *newest_imu_ns_ + max_bridged_gap_ns_);
+  const std::int64_t horizon_ns = fusion_horizon(stamp_ns);
+  while (next_output_ns_ != 0 && next_output_ns_ <= horizon_ns) {
+    const std::int64_t instant_ns = next_output_ns_;
+    emit_step(out);
+    fuse_covered(instant_ns);
   }
-  while (next_output_ns_ != 0 && next_output_ns_ <= stamp_ns) emit_step(out);
-  fusion_->advance_to(stamp_ns);
+  fusion_->advance_to(horizon_ns);
+  fuse_covered(horizon_ns);
+}
+
+void FusionDriver::fuse_when_covered(PendingResult result) {
+  pending_.push_back(std::move(result));
+  fuse_covered(fusion_horizon(clock_ns_));
+}
+
+void FusionDriver::fuse_covered(std::int64_t horizon_ns) {
+  // an initialised filter takes a result once it has stepped past its stamp (delay compensation)
+  while (fusion_ && !pending_.empty() && pending_.front().stamp_ns <= horizon_ns &&
+         (!fusion_->initialized() || pending_.front().stamp_ns <= fusion_->time_ns())) {
+    const PendingResult r = std::move(pending_.front());
+    pending_.pop_front();
+    fusion_->add_lidar(r.stamp_ns, r.body_pose, r.velocity_m_s, r.has_velocity, r.covariance, r.velocity_covariance);
+  }
 }
 
 void FusionDriver::apply_gyro_unit() {
@@ -375,7 +401,7 @@ void FusionDriver::link(const Scan& scan, OdometryFrame& frame) {
             fusion::velocity_measurement_covariance(*covariance, *last_covariance_, dt_s, fusion_->config());
       }
     }
-    fusion_->add_lidar(stamp_ns, frame.body_pose, velocity, has_velocity, covariance, velocity_covariance);
+    fuse_when_covered({stamp_ns, frame.body_pose, velocity, has_velocity, covariance, velocity_covariance});
     frame.fused = true;
   }
   last_body_ = StampedPose{scan.end_stamp_ns, frame.body_pose};

@@ -4,7 +4,9 @@
 // drive, so that the two cannot drift apart. They differ only in their clock: the replay feeds the
 // recording's IMU up to a simulated time, the online odometry each sample as it arrives.
 //   the fusion clock: IMU samples in, the EKF stepped, one odometry sample every fusion.step_s,
-//     each computed from exactly the IMU samples stamped up to its instant;
+//     each computed from the IMU samples around its instant (interpolated); the filter steps only
+//     as far as the newest sample while the next is due (fusion.imu_gate.gap_limit_s), and a LiDAR
+//     result ahead of it waits until the filter has passed its stamp;
 //   before a scan: the start pose (roll and pitch from gravity when the first IMU samples look
 //     unaccelerated) at the first scan, the fusion's pose at the scan end as the initial guess,
 //     and a regression over its pose history during the scan as the motion for the undistortion;
@@ -70,6 +72,17 @@ struct ScanPrior {
   std::optional<SE3> guess;                  ///< LiDAR pose at the scan end
   std::optional<deskew::ScanMotion> motion;  ///< LiDAR motion during the scan
   bool fused = false;                        ///< from the filter
+};
+
+/// A LiDAR result for the fusion (FusionDriver::link): the body pose at the scan end, its
+/// registration covariance, and the velocity from the previous result (eq. 6).
+struct PendingResult {
+  std::int64_t stamp_ns = 0;
+  SE3 body_pose;
+  Eigen::Vector3d velocity_m_s = Eigen::Vector3d::Zero();
+  bool has_velocity = false;
+  std::optional<Mat6d> covariance;
+  std::optional<Eigen::Matrix3d> velocity_covariance;
 };
 
 /// Why a scan's result must not reach the fusion; empty when it may.
@@ -148,6 +161,14 @@ class FusionDriver {
   /// Before the filter: a scan with a degenerate translation restarts the initialisation window and
   /// is not fused (with a warning once such scans have held the start for a while).
   void hold_start_at_degenerate_scan(std::int64_t stamp_ns, OdometryFrame& frame);
+  /// Fuses `result` now, or once the IMU reaches its stamp (a LiDAR result ahead of the newest
+  /// IMU sample waits: the filter predicts only with inputs it has).
+  void fuse_when_covered(PendingResult result);
+  /// Fuses the waiting results that the IMU now covers, up to `horizon_ns`.
+  void fuse_covered(std::int64_t horizon_ns);
+  /// How far the filter may step for a clock at `stamp_ns`: the newest IMU sample while the next one
+  /// is not overdue (fusion.imu_gate.gap_limit_s); across a gap, up to max_bridged_gap_s past it.
+  [[nodiscard]] std::int64_t fusion_horizon(std::int64_t stamp_ns) const;
   /// The sample with its gyro in rad/s.
   [[nodiscard]] ImuSample in_si_units(const ImuSample& sample) const;
   void warn(std::string message);
@@ -175,6 +196,7 @@ class FusionDriver {
   std::optional<std::int64_t> last_output_ns_;
   std::optional<StampedPose> last_body_;  ///< the previous processed scan's body pose
   std::optional<Mat6d> last_covariance_;  ///< and its registration covariance
+  std::deque<PendingResult> pending_;     ///< LiDAR results ahead of the newest IMU sample
   std::vector<std::string> warnings_;
 };
 

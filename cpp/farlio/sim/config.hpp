@@ -78,6 +78,9 @@ struct SimConfig {
   LidarModel lidar_model = LidarModel::Profile;
   double lidar_rate_hz = 0.0;
   double imu_rate_hz = 0.0;
+  /// The IMU's samples fall this long after the whole IMU periods of the sequence clock, in [0,
+  /// 1 / imu_rate_hz): an IMU is not phase-locked to the LiDAR or to the fusion's step grid.
+  double imu_time_offset_s = 0.0;
   double gravity_m_s2 = 0.0;
 };
 

@@ -19,7 +19,8 @@ ImuSample ideal_imu_reading(const BodyState& s, double gravity_m_s2) {
 }
 
 std::vector<ImuSample> generate_imu(const MotionModel& motion, const SimConfig& config) {
-  const auto count = static_cast<std::size_t>(std::floor(config.duration_s * config.imu_rate_hz)) + 1;
+  const auto count =
+      static_cast<std::size_t>(std::floor((config.duration_s - config.imu_time_offset_s) * config.imu_rate_hz)) + 1;
   const double dt_s = 1.0 / config.imu_rate_hz;
   const NoiseConfig& n = config.noise;
   Eigen::Vector3d gyro_bias = n.gyro_bias_initial_rad_s, accel_bias = n.accel_bias_initial_m_s2;
@@ -37,7 +38,7 @@ std::vector<ImuSample> generate_imu(const MotionModel& motion, const SimConfig& 
   std::vector<ImuSample> out;
   out.reserve(count);
   for (std::size_t k = 0; k < count; ++k) {
-    const double t_s = static_cast<double>(k) * dt_s;
+    const double t_s = static_cast<double>(k) * dt_s + config.imu_time_offset_s;
     const BodyState state = motion.state(t_s);
     ImuSample s = ideal_imu_reading(state, config.gravity_m_s2);
     s.stamp_ns = config.start_stamp_ns + seconds_to_ns(t_s);

@@ -90,6 +90,8 @@ SequenceGenerator::SequenceGenerator(const SimConfig& config) : config_(config) 
     throw std::invalid_argument("SimConfig: motion_start_s must be finite and not negative");
   motion_ = config_.motion_start_s > 0.0 ? std::make_shared<const LaterStart>(world_->motion, config_.motion_start_s)
                                          : world_->motion;
+  if (!(config_.imu_time_offset_s >= 0.0) || !(config_.imu_time_offset_s * config_.imu_rate_hz < 1.0))
+    throw std::invalid_argument("SimConfig: imu_time_offset_s must be in [0, 1 / imu_rate_hz)");
   validate_imu_errors(config_.imu_errors);
   period_ns_ = std::llround(kNsPerS / config_.lidar_rate_hz);
 }
@@ -237,6 +239,7 @@ std::map<std::string, std::string> SequenceGenerator::description() const {
   d["lidar_model"] = lidar_model_name(config_.lidar_model);
   d["lidar_rate_hz"] = num(config_.lidar_rate_hz);
   d["imu_rate_hz"] = num(config_.imu_rate_hz);
+  d["imu_time_offset_s"] = num(config_.imu_time_offset_s);
   d["gravity_m_s2"] = num(config_.gravity_m_s2);
   d["num_scans"] = std::to_string(num_scans());
   d["num_primitives"] = std::to_string(world_->scene.num_primitives());

@@ -72,6 +72,14 @@ def _add_sensor_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="HZ",
         help="IMU samples per second (default: the profile's; 10 Hz is KITTI raw's OXTS rate)",
     )
+    parser.add_argument(
+        "--imu-offset",
+        type=non_negative_float,
+        default=0.0,
+        metavar="S",
+        help="the IMU's samples fall S seconds after the whole IMU periods of the sequence clock (default 0; below "
+        "one IMU period), as an IMU that is not phase-locked to the LiDAR",
+    )
 
 
 def _add_noise_arguments(parser: argparse.ArgumentParser) -> None:
@@ -127,6 +135,7 @@ def run(args: argparse.Namespace) -> int:
         lidar=args.lidar,
         lidar_rate_hz=args.lidar_rate,
         imu_rate_hz=args.imu_rate,
+        imu_time_offset_s=args.imu_offset,
         range_noise_std_m=args.range_noise,
         dropout_probability=args.dropout,
         gyro_noise_std_rad_s=args.gyro_noise,
