@@ -163,6 +163,7 @@ void FusionDriver::jump_clock(const ImuSample& sample) {
        " s), and the samples after it follow it: the fusion is reset and starts again from the next LiDAR results");
   recent_imu_.clear();
   pending_.clear();  // stamped on the old clock
+  pending_rotations_.clear();
   gyro_unit_.forget_samples();
   restart_fusion(recent_imu_, /*regrid=*/true);
   clock_ns_ = sample.stamp_ns;
@@ -209,6 +210,12 @@ void FusionDriver::feed_imu(const ImuSample& sample, Samples& out) {
   if (next_output_ns_ == 0) next_output_ns_ = (sample.stamp_ns / step_ns + 1) * step_ns;
   fusion_->add_imu(si);
   advance_to(sample.stamp_ns, out);
+  compare_covered_rotations();
+}
+
+bool FusionDriver::beyond_bridged_gap(std::int64_t stamp_ns) const {
+  return newest_imu_ns_ &&
+         ns_to_seconds(stamp_ns) - ns_to_seconds(*newest_imu_ns_) > fusion_config_.imu_gate.max_bridged_gap_s;
 }
 
 std::int64_t FusionDriver::fusion_horizon(std::int64_t stamp_ns) const {
@@ -253,7 +260,7 @@ void FusionDriver::apply_gyro_unit() {
     case fusion::GyroUnit::kDegreesPerSecond:
       warn(gyro_unit_.message());
       restart_fusion(recent_imu_, /*regrid=*/false);
-      fusion_->advance_to(clock_ns_);
+      fusion_->advance_to(fusion_horizon(clock_ns_));
       break;
     case fusion::GyroUnit::kStuck:
       warn(gyro_unit_.message());
@@ -330,15 +337,32 @@ void FusionDriver::compare_gyro_unit(std::int64_t stamp_ns, const OdometryFrame&
   // turn the gyro did not make
   const bool constrained = !frame.degeneracy || !frame.degeneracy->degenerate();
   if (!frame.drop_reason.empty() || !fusion_ || !has_imu() || gyro_unit_.decided() || !last_body_ ||
-      stamp_ns <= last_body_->stamp_ns || !constrained)
+      stamp_ns <= last_body_->stamp_ns || !constrained || beyond_bridged_gap(stamp_ns))
     return;
-  const Eigen::Vector3d lidar_rotation = so3_log((last_body_->pose.inverse() * frame.body_pose).rotation());
-  const auto gyro_rotation = fusion_->imu_rotation(last_body_->stamp_ns, stamp_ns);
-  gyro_follows_lidar_ =
-      gyro_rotation &&
-      so3_log(*gyro_rotation).norm() <= kRotationAgreementRatio * lidar_rotation.norm() + kRotationAgreementFloor_rad;
-  gyro_unit_.add_lidar_rotation(last_body_->stamp_ns, stamp_ns, lidar_rotation);
-  if (gyro_unit_.decided()) apply_gyro_unit();
+  pending_rotations_.push_back(
+      {last_body_->stamp_ns, stamp_ns, so3_log((last_body_->pose.inverse() * frame.body_pose).rotation())});
+  compare_covered_rotations();
+}
+
+void FusionDriver::compare_covered_rotations() {
+  // the gyro's rotation over an interval once the IMU covers it (a 10 Hz IMU's next sample may come
+  // after the scan's result)
+  while (fusion_ && !gyro_unit_.decided() && !pending_rotations_.empty() && newest_imu_ns_ &&
+         pending_rotations_.front().end_ns <= *newest_imu_ns_) {
+    const PendingRotation r = pending_rotations_.front();
+    pending_rotations_.pop_front();
+    const auto gyro_rotation = fusion_->imu_rotation(r.start_ns, r.end_ns);
+    gyro_follows_lidar_ =
+        gyro_rotation && so3_log(*gyro_rotation).norm() <=
+                             kRotationAgreementRatio * r.lidar_rotation.norm() + kRotationAgreementFloor_rad;
+    gyro_unit_.add_lidar_rotation(r.start_ns, r.end_ns, r.lidar_rotation);
+    if (gyro_unit_.decided()) apply_gyro_unit();
+    warn_undecided_gyro(r.end_ns);
+  }
+  if (gyro_unit_.decided()) pending_rotations_.clear();
+}
+
+void FusionDriver::warn_undecided_gyro(std::int64_t stamp_ns) {
   if (!first_compared_ns_) first_compared_ns_ = stamp_ns;
   if (!gyro_unit_.decided() && !warned_undecided_gyro_ &&
       ns_to_seconds(stamp_ns - *first_compared_ns_) > kUndecidedGyroWarning_s) {
@@ -389,6 +413,11 @@ void FusionDriver::link(const Scan& scan, OdometryFrame& frame) {
         " s before the IMU clock, beyond fusion.imu_gate.max_bridged_gap_s (do the IMU and LiDAR clocks differ?)";
   }
   hold_start_at_degenerate_scan(stamp_ns, frame);
+  if (frame.drop_reason.empty() && fusion_ && has_imu() && beyond_bridged_gap(stamp_ns)) {
+    frame.drop_reason =
+        "not fused: the scan ends " + seconds_text(ns_to_seconds(stamp_ns) - ns_to_seconds(*newest_imu_ns_)) +
+        " s after the newest IMU sample, beyond fusion.imu_gate.max_bridged_gap_s (has the IMU stopped?)";
+  }
   if (frame.drop_reason.empty() && fusion_ && has_imu()) {
     Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
     std::optional<Eigen::Matrix3d> velocity_covariance;

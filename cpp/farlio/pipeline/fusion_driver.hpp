@@ -28,6 +28,8 @@
 //   a gyro in deg/s is scaled (the fusion starts again), a stuck gyro or a silent accelerometer
 //     ends the fusion (LiDAR-only): fusion/gyro_unit_detector.hpp; a unit still undecided after
 //     kUndecidedGyroWarning_s of scans is a warning;
+//   a result more than fusion.imu_gate.max_bridged_gap_s after the newest IMU sample (the IMU
+//     stopped) is not fused, with that drop reason; one less far waits for the IMU to cover it;
 //   results before the first IMU sample are not fused (no IMU yet: LiDAR-only until it comes),
 //     with that drop reason and one warning;
 //   a result with a degenerate translation does not initialise the filter (its pose says nothing
@@ -158,6 +160,10 @@ class FusionDriver {
   /// While the gyro's unit is undecided: compares the gyro's rotation with the LiDAR's over the
   /// last scan interval (scans with a degenerate direction left out) and applies a decision.
   void compare_gyro_unit(std::int64_t stamp_ns, const OdometryFrame& frame);
+  /// Hands the detector the intervals the IMU now covers (compare_gyro_unit queues them).
+  void compare_covered_rotations();
+  /// One warning once the unit is still undecided kUndecidedGyroWarning_s after the first comparison.
+  void warn_undecided_gyro(std::int64_t stamp_ns);
   /// Before the filter: a scan with a degenerate translation restarts the initialisation window and
   /// is not fused (with a warning once such scans have held the start for a while).
   void hold_start_at_degenerate_scan(std::int64_t stamp_ns, OdometryFrame& frame);
@@ -169,6 +175,9 @@ class FusionDriver {
   /// How far the filter may step for a clock at `stamp_ns`: the newest IMU sample while the next one
   /// is not overdue (fusion.imu_gate.gap_limit_s); across a gap, up to max_bridged_gap_s past it.
   [[nodiscard]] std::int64_t fusion_horizon(std::int64_t stamp_ns) const;
+  /// Whether stamp_ns lies more than fusion.imu_gate.max_bridged_gap_s after the newest IMU sample
+  /// (a result there is not fused: the filter cannot reach it).
+  [[nodiscard]] bool beyond_bridged_gap(std::int64_t stamp_ns) const;
   /// The sample with its gyro in rad/s.
   [[nodiscard]] ImuSample in_si_units(const ImuSample& sample) const;
   void warn(std::string message);
@@ -196,7 +205,14 @@ class FusionDriver {
   std::optional<std::int64_t> last_output_ns_;
   std::optional<StampedPose> last_body_;  ///< the previous processed scan's body pose
   std::optional<Mat6d> last_covariance_;  ///< and its registration covariance
-  std::deque<PendingResult> pending_;     ///< LiDAR results ahead of the newest IMU sample
+  /// A LiDAR rotation between two scans, for the gyro unit detector once the IMU covers it.
+  struct PendingRotation {
+    std::int64_t start_ns = 0;
+    std::int64_t end_ns = 0;
+    Eigen::Vector3d lidar_rotation = Eigen::Vector3d::Zero();
+  };
+  std::deque<PendingRotation> pending_rotations_;
+  std::deque<PendingResult> pending_;  ///< LiDAR results ahead of the newest IMU sample
   std::vector<std::string> warnings_;
 };
 

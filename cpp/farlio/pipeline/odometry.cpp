@@ -86,7 +86,8 @@ void Odometry::advance_clock(std::int64_t stamp_ns) {
   if (stamp_ns <= clock_ns_) return;
   if (driver_.inertial()) {
     // The fusion never runs past the recording's last IMU sample: beyond it there is no data, not
-    // a gap (results that arrive later are fused at that time, with their delay compensated).
+    // a gap (results stamped before it that arrive later are fused at that time, with their delay
+    // compensated; results stamped after it wait for samples that never come and are not fused).
     const std::int64_t fusion_until = std::min(stamp_ns, imu_.back().stamp_ns);
     outputs_.clear();
     while (next_imu_ < imu_.size() && imu_[next_imu_].stamp_ns <= fusion_until) {
