@@ -1,29 +1,56 @@
 #!/usr/bin/env python3
-"""IMU rate and clock (docs/fusion.md, "IMU rate and clock"): the LIO with the IMU at other rates
-and off the scans' clock, against the profile's own IMU and LiDAR-only on the same scans.
+"""IMU rate, clock and noise (docs/fusion.md, "IMU rate and clock"): the LIO with the IMU at other
+rates, off the scans' clock, noisier, or with samples missing, against the profile's own IMU and
+LiDAR-only on the same scans.
 
-Per IMU (rate in Hz, and the offset of its samples from the scans' clock in s) and seed: APE (m),
+IMUs: `profile`; `RATE` or `RATE:OFFSET` (Hz, and the offset of its samples from the scans' clock
+in s); `racing` (the profile's rate with white noise of 3e-3 rad/s/sqrt(Hz) and 7e-2
+m/s^2/sqrt(Hz), a vibrating race car's); `drop:N` (every N-th sample missing, a driver that drops
+samples); `gap:START:LENGTH` (no sample for LENGTH s from START s). Per IMU and seed: APE (m),
 KITTI-style RPE (%) and rotation RMSE (deg) of the scan poses, APE and RPE of the 100 Hz odometry,
 LiDAR results rejected by the filter's gate and re-initialisations; the deterministic replay at a
 fixed 20 ms latency (farlio.simulation.replay).
 
   python figures/fusion_imu_rates.py --profile urban --duration 30 --seeds 1 2 --imus 10 10:0.04 profile
+  python figures/fusion_imu_rates.py --profile racetrack --duration 30 --seeds 1 2 \
+      --imus profile racing drop:7 gap:15:0.5
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 
 from farlio.simulation import PROFILES, Recording, make_config, replay, stretch_accuracy
 from harness import FIXED_LATENCY_S, LIDAR_ONLY
 
+#: a vibrating race car's IMU: white noise densities (rad/s/sqrt(Hz), m/s^2/sqrt(Hz))
+RACING_GYRO_DENSITY, RACING_ACCEL_DENSITY = 3e-3, 7e-2
 
-def parse_imu(text: str) -> tuple[float | None, float]:
-    """'profile', 'RATE' or 'RATE:OFFSET' -> (rate or None for the profile's, offset s)."""
-    if text == "profile":
-        return None, 0.0
-    rate, _, offset = text.partition(":")
-    return float(rate), float(offset or 0.0)
+
+def recording(profile: str, seed: int, duration_s: float, imu: str) -> Recording:
+    """The profile's recording with the IMU `imu` (see the module's docstring)."""
+    kind, _, rest = imu.partition(":")
+    if kind in ("profile", "drop", "gap"):
+        rec = Recording(make_config(profile, seed=seed, duration_s=duration_s))
+    elif kind == "racing":
+        rate = make_config(profile).imu_rate_hz
+        noise = {"gyro_noise_std_rad_s": RACING_GYRO_DENSITY * math.sqrt(rate)}
+        noise["accel_noise_std_m_s2"] = RACING_ACCEL_DENSITY * math.sqrt(rate)
+        rec = Recording(make_config(profile, seed=seed, duration_s=duration_s, **noise))
+    else:
+        offset = float(rest or 0.0)
+        rec = Recording(
+            make_config(profile, seed=seed, duration_s=duration_s, imu_rate_hz=float(kind), imu_time_offset_s=offset)
+        )
+    if kind == "drop":
+        every = int(rest)
+        rec.imu = [s for i, s in enumerate(rec.imu) if i % every != every - 1]
+    elif kind == "gap":
+        start_s, length_s = (float(v) for v in rest.split(":"))
+        t0 = rec.imu[0].stamp_ns
+        rec.imu = [s for s in rec.imu if not (start_s <= (s.stamp_ns - t0) / 1e9 < start_s + length_s)]
+    return rec
 
 
 def row(label: str, a: dict) -> str:
@@ -39,7 +66,10 @@ def main() -> int:
     p.add_argument("--duration", type=float, default=30.0, help="seconds from a standstill")
     p.add_argument("--seeds", type=int, nargs="+", default=[1, 2])
     p.add_argument(
-        "--imus", nargs="+", default=["10", "10:0.04", "profile"], help="IMUs: 'profile', RATE or RATE:OFFSET_S"
+        "--imus",
+        nargs="+",
+        default=["10", "10:0.04", "profile"],
+        help="IMUs: profile, RATE, RATE:OFFSET_S, racing, drop:N, gap:START_S:LENGTH_S",
     )
     args = p.parse_args()
     print("columns: ape_m rpe_pct rot_deg odom_ape_m odom_rpe_pct rejected reinit")
@@ -47,12 +77,7 @@ def main() -> int:
         print(f"{args.profile} {args.duration:g} s, seed {seed}")
         lidar_only = None
         for imu in args.imus:
-            rate, offset = parse_imu(imu)
-            rec = Recording(
-                make_config(
-                    args.profile, seed=seed, duration_s=args.duration, imu_rate_hz=rate, imu_time_offset_s=offset
-                )
-            )
+            rec = recording(args.profile, seed, args.duration, imu)
             print(
                 row(f"LIO, IMU {imu}", stretch_accuracy(replay(rec, [], fixed_latency_s=FIXED_LATENCY_S))), flush=True
             )
