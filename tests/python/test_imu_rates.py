@@ -1,9 +1,9 @@
 """The fusion takes an IMU at any rate: a 10 Hz IMU (KITTI raw's OXTS rate) through an urban corner
 is interpolated between its samples, so the filter turns with the car, no LiDAR result is rejected
 and the filter never re-initialises, and the LIO stays at least as accurate as LiDAR-only on the
-same scans (docs/fusion.md, "IMU rate and clock"). With the last sample held until the next one,
-the filter's yaw lagged 0.9 deg behind the corner at 26 s, 17 LiDAR results were rejected and the
-filter re-initialised (seed 1). With the samples 40 ms after the scans' ends (an IMU not
+same scans (docs/fusion.md, "IMU rate and clock"). Holding the last sample until the next one
+instead puts the filter's yaw 0.9 deg behind the corner at 26 s, and 17 LiDAR results are rejected
+before the filter re-initialises (seed 1). With the samples 40 ms after the scans' ends (an IMU not
 phase-locked to the LiDAR), the gyro's unit is judged once the IMU covers each scan interval, and
 the LIO stays ahead of LiDAR-only in APE and RPE."""
 
