@@ -21,18 +21,18 @@ from __future__ import annotations
 import argparse
 import math
 
-from farlio.simulation import PROFILES, Recording, make_config, replay, stretch_accuracy
+from farlio.simulation import IMU_GRADES, PROFILES, Recording, make_config, replay, stretch_accuracy
 from harness import FIXED_LATENCY_S, LIDAR_ONLY
 
 #: a vibrating race car's IMU: white noise densities (rad/s/sqrt(Hz), m/s^2/sqrt(Hz))
 RACING_GYRO_DENSITY, RACING_ACCEL_DENSITY = 3e-3, 7e-2
 
 
-def recording(profile: str, seed: int, duration_s: float, imu: str) -> Recording:
-    """The profile's recording with the IMU `imu` (see the module's docstring)."""
+def recording(profile: str, seed: int, duration_s: float, imu: str, grade: str = "profile") -> Recording:
+    """The profile's recording with the IMU `imu` (see the module's docstring) of `grade`."""
     kind, _, rest = imu.partition(":")
     if kind in ("profile", "drop", "gap"):
-        rec = Recording(make_config(profile, seed=seed, duration_s=duration_s))
+        rec = Recording(make_config(profile, seed=seed, duration_s=duration_s, imu_grade=grade))
     elif kind == "racing":
         rate = make_config(profile).imu_rate_hz
         noise = {"gyro_noise_std_rad_s": RACING_GYRO_DENSITY * math.sqrt(rate)}
@@ -71,18 +71,20 @@ def main() -> int:
         default=["10", "10:0.04", "profile"],
         help="IMUs: profile, RATE, RATE:OFFSET_S, racing, drop:N, gap:START_S:LENGTH_S",
     )
+    p.add_argument("--imu-grade", choices=IMU_GRADES, default="profile", help="for profile, drop and gap")
+    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="NAME=VALUE", help="config override")
     args = p.parse_args()
     print("columns: ape_m rpe_pct rot_deg odom_ape_m odom_rpe_pct rejected reinit")
     for seed in args.seeds:
         print(f"{args.profile} {args.duration:g} s, seed {seed}")
         lidar_only = None
         for imu in args.imus:
-            rec = recording(args.profile, seed, args.duration, imu)
-            print(
-                row(f"LIO, IMU {imu}", stretch_accuracy(replay(rec, [], fixed_latency_s=FIXED_LATENCY_S))), flush=True
-            )
+            rec = recording(args.profile, seed, args.duration, imu, args.imu_grade)
+            lio = stretch_accuracy(replay(rec, args.overrides, fixed_latency_s=FIXED_LATENCY_S))
+            print(row(f"LIO, IMU {imu}", lio), flush=True)
             if lidar_only is None:
-                lidar_only = stretch_accuracy(replay(rec, [LIDAR_ONLY], fixed_latency_s=FIXED_LATENCY_S))
+                only = [*args.overrides, LIDAR_ONLY]
+                lidar_only = stretch_accuracy(replay(rec, only, fixed_latency_s=FIXED_LATENCY_S))
                 print(row("LiDAR-only", lidar_only), flush=True)
     return 0
 
