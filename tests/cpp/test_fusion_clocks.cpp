@@ -76,6 +76,21 @@ ReplayRun replay(const Recording& rec, std::vector<ImuSample> imu, const std::ve
   return run;
 }
 
+/// The largest rotation between outputs of `run` and `reference` at the same stamp (deg); `compared`
+/// counts those stamps.
+double max_rotation_difference_deg(const std::vector<OdometrySample>& run, const std::vector<OdometrySample>& reference,
+                                   std::size_t* compared = nullptr) {
+  double max_deg = 0.0;
+  for (const OdometrySample& s : run) {
+    const auto same = std::find_if(reference.begin(), reference.end(),
+                                   [&](const OdometrySample& f) { return f.stamp_ns == s.stamp_ns; });
+    if (same == reference.end()) continue;
+    max_deg = std::max(max_deg, kDegPerRad * (same->body_pose.inverse() * s.body_pose).angle_rad());
+    if (compared) ++*compared;
+  }
+  return max_deg;
+}
+
 double final_position_error_m(const Recording& rec, const ReplayRun& run) {
   return test::final_position_error_m(rec, run.frames.front().body_pose, run.frames.back().body_pose);
 }
@@ -412,18 +427,10 @@ TEST(ReplayClocks, AnImuSlowerThanTheStepIsInterpolatedNotHeld) {
   const ReplayRun full = replay(rec, rec.imu);
   std::vector<ImuSample> slow;
   for (std::size_t i = 0; i < rec.imu.size(); i += kEvery) slow.push_back(rec.imu[i]);
-  const ReplayRun run = replay(rec, slow);
-  double max_deg = 0.0;
   std::size_t compared = 0;
-  for (const OdometrySample& s : run.outputs) {
-    const auto same = std::find_if(full.outputs.begin(), full.outputs.end(),
-                                   [&](const OdometrySample& f) { return f.stamp_ns == s.stamp_ns; });
-    if (same == full.outputs.end()) continue;
-    max_deg = std::max(max_deg, kDegPerRad * (same->body_pose.inverse() * s.body_pose).angle_rad());
-    ++compared;
-  }
+  // 0.08 deg; 0.21 deg with the input held
+  EXPECT_LT(max_rotation_difference_deg(replay(rec, slow).outputs, full.outputs, &compared), 0.12);
   EXPECT_GT(compared, full.outputs.size() / 2);
-  EXPECT_LT(max_deg, 0.12);  // 0.08 deg; 0.21 deg with the input held
 
   // the samples 40 ms after the scans' clock: outputs come as the IMU covers them
   std::vector<ImuSample> offset;
@@ -431,15 +438,7 @@ TEST(ReplayClocks, AnImuSlowerThanTheStepIsInterpolatedNotHeld) {
   // the gyro's rotation over a scan interval is compared with the LiDAR's once the IMU covers it,
   // so the gyro's unit is decided and the fusion's guess serves the corner: 0.37 deg from the
   // full-rate output (0.74 deg with the input held and the unit never decided)
-  const ReplayRun off = replay(rec, offset);
-  double off_max_deg = 0.0;
-  for (const OdometrySample& s : off.outputs) {
-    const auto same = std::find_if(full.outputs.begin(), full.outputs.end(),
-                                   [&](const OdometrySample& f) { return f.stamp_ns == s.stamp_ns; });
-    if (same != full.outputs.end())
-      off_max_deg = std::max(off_max_deg, kDegPerRad * (same->body_pose.inverse() * s.body_pose).angle_rad());
-  }
-  EXPECT_LT(off_max_deg, 0.45);
+  EXPECT_LT(max_rotation_difference_deg(replay(rec, offset).outputs, full.outputs), 0.45);
   ReplayOptions zero;
   zero.latency = LatencyModel::Zero;
   Odometry odo(deterministic_config(), rec.T_imu_lidar, rec.gravity_m_s2, offset, zero);

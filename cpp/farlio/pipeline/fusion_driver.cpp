@@ -132,9 +132,9 @@ void FusionDriver::restart_fusion(const std::deque<ImuSample>& samples, bool reg
   if (!samples.empty()) fusion_->advance_to(samples.back().stamp_ns);
 }
 
-double FusionDriver::jump_s(const ImuSample& sample) const {
+double FusionDriver::after_newest_imu_s(std::int64_t stamp_ns) const {
   // in seconds: the difference of two arbitrary int64 stamps may not fit an int64
-  return newest_imu_ns_ ? ns_to_seconds(sample.stamp_ns) - ns_to_seconds(*newest_imu_ns_) : 0.0;
+  return newest_imu_ns_ ? ns_to_seconds(stamp_ns) - ns_to_seconds(*newest_imu_ns_) : 0.0;
 }
 
 bool FusionDriver::admit(const ImuSample& sample) {
@@ -157,9 +157,10 @@ bool FusionDriver::admit(const ImuSample& sample) {
 }
 
 void FusionDriver::jump_clock(const ImuSample& sample) {
-  warn("IMU stamp " + seconds_text(ns_to_seconds(sample.stamp_ns)) + " s jumps by " + seconds_text(jump_s(sample)) +
-       " s from the newest (" + seconds_text(ns_to_seconds(*newest_imu_ns_)) +
-       " s), beyond fusion.imu_gate.max_bridged_gap_s (" + seconds_text(fusion_config_.imu_gate.max_bridged_gap_s) +
+  warn("IMU stamp " + seconds_text(ns_to_seconds(sample.stamp_ns)) + " s jumps by " +
+       seconds_text(after_newest_imu_s(sample.stamp_ns)) + " s from the newest (" +
+       seconds_text(ns_to_seconds(*newest_imu_ns_)) + " s), beyond fusion.imu_gate.max_bridged_gap_s (" +
+       seconds_text(fusion_config_.imu_gate.max_bridged_gap_s) +
        " s), and the samples after it follow it: the fusion is reset and starts again from the next LiDAR results");
   recent_imu_.clear();
   pending_.clear();  // stamped on the old clock
@@ -183,11 +184,11 @@ void FusionDriver::add_imu(const ImuSample& sample, Samples& out) {
       feed_imu(held, out);
     } else {
       warn("IMU sample stamped " + seconds_text(ns_to_seconds(held.stamp_ns)) + " s jumps by " +
-           seconds_text(jump_s(held)) + " s from the samples around it: dropped");
+           seconds_text(after_newest_imu_s(held.stamp_ns)) + " s from the samples around it: dropped");
     }
   }
   if (!fusion_) return;
-  if (std::abs(jump_s(sample)) > fusion_config_.imu_gate.max_bridged_gap_s) {
+  if (std::abs(after_newest_imu_s(sample.stamp_ns)) > fusion_config_.imu_gate.max_bridged_gap_s) {
     held_jump_ = sample;
     return;
   }
@@ -214,14 +215,12 @@ void FusionDriver::feed_imu(const ImuSample& sample, Samples& out) {
 }
 
 bool FusionDriver::beyond_bridged_gap(std::int64_t stamp_ns) const {
-  return newest_imu_ns_ &&
-         ns_to_seconds(stamp_ns) - ns_to_seconds(*newest_imu_ns_) > fusion_config_.imu_gate.max_bridged_gap_s;
+  return newest_imu_ns_ && after_newest_imu_s(stamp_ns) > fusion_config_.imu_gate.max_bridged_gap_s;
 }
 
 std::int64_t FusionDriver::fusion_horizon(std::int64_t stamp_ns) const {
   if (!newest_imu_ns_ || stamp_ns <= *newest_imu_ns_) return stamp_ns;
-  const double ahead_s = ns_to_seconds(stamp_ns) - ns_to_seconds(*newest_imu_ns_);
-  if (ahead_s <= fusion_config_.imu_gate.gap_limit_s) return *newest_imu_ns_;  // the next sample is due
+  if (after_newest_imu_s(stamp_ns) <= fusion_config_.imu_gate.gap_limit_s) return *newest_imu_ns_;  // next one due
   // a gap: the fusion predicts with its last input, at most the bridged gap beyond the newest sample
   if (*newest_imu_ns_ >= std::numeric_limits<std::int64_t>::max() - max_bridged_gap_ns_) return stamp_ns;
   return std::min(stamp_ns, *newest_imu_ns_ + max_bridged_gap_ns_);
@@ -415,7 +414,7 @@ void FusionDriver::link(const Scan& scan, OdometryFrame& frame) {
   hold_start_at_degenerate_scan(stamp_ns, frame);
   if (frame.drop_reason.empty() && fusion_ && has_imu() && beyond_bridged_gap(stamp_ns)) {
     frame.drop_reason =
-        "not fused: the scan ends " + seconds_text(ns_to_seconds(stamp_ns) - ns_to_seconds(*newest_imu_ns_)) +
+        "not fused: the scan ends " + seconds_text(after_newest_imu_s(stamp_ns)) +
         " s after the newest IMU sample, beyond fusion.imu_gate.max_bridged_gap_s (has the IMU stopped?)";
   }
   if (frame.drop_reason.empty() && fusion_ && has_imu()) {

@@ -148,8 +148,9 @@ class FusionDriver {
   bool admit(const ImuSample& sample);
   /// The sample through admit into the fusion, emitting the odometry up to its stamp.
   void feed_imu(const ImuSample& sample, Samples& out);
-  /// How far the sample's stamp is from the newest (s; 0 before the first).
-  [[nodiscard]] double jump_s(const ImuSample& sample) const;
+  /// How far stamp_ns lies after the newest IMU sample (s; negative before it, 0 before the first
+  /// sample).
+  [[nodiscard]] double after_newest_imu_s(std::int64_t stamp_ns) const;
   /// The IMU clock jumped to `sample`: the fusion is reset there.
   void jump_clock(const ImuSample& sample);
   /// After the gyro unit was decided: scales and restarts, or ends the fusion.
