@@ -10,6 +10,9 @@
 #      100-frame and odometry tests, whose kernels the short pipeline test runs too);
 #   5. with NCU=1: Nsight Compute's duration of every kernel over 20 urban frames, summed per
 #      kernel and per frame (scripts/gpu_kernel_table.py), against the frame's wall time;
+#   5b. with BASELINE=DIR (a build of another commit, made by --pack): its gpu_pipeline on the same
+#      scans between two more runs of this build's (GPU only), and with NCU=1 its kernel profile
+#      too: before and after on one machine in one call;
 #   6. with PYTHON=1: build the Python package there (pip, no index: the GPU image's own
 #      scikit-build-core, nanobind, numpy, matplotlib, PyYAML) and run the command line tool on the
 #      GPU: `farlio run --device cuda` and `--device cpu` on a generated 10 s urban sequence (their
@@ -20,7 +23,8 @@
 # sanitizers cannot pass for one with them.
 # Environment: BUILD (default build/gpu), CUDA_ARCH (default native), FRAMES (default 100),
 # JOBS (default nproc), SCANS (a folder of scans for the timing), SKIP_SANITIZERS=1,
-# PREBUILT (a folder made by --pack: run its binaries, build nothing), NCU=1, PYTHON=1.
+# PREBUILT (a folder made by --pack: run its binaries, build nothing), BASELINE (likewise, the
+# build to compare with), NCU=1, PYTHON=1.
 #
 #   scripts/gpu_check.sh --pack DIR   (on the build machine, after building BUILD with CUDA)
 # copies the two executables, stripped, and the shared libraries they need that are not the C
@@ -148,6 +152,14 @@ bench_args=(--frames "$FRAMES" --profile urban --profile racetrack)
 [ -n "${SCANS:-}" ] && bench_args+=(--scans "$SCANS")
 step "scan pipeline timing" timing.log "$BENCH_LIMIT_S" "$bin/gpu_pipeline" "${bench_args[@]}" || status=1
 
+# The baseline build on the same scans, between two more runs of this one (GPU only).
+if [ -n "${BASELINE:-}" ]; then
+  step "baseline timing" baseline_timing.log "$BENCH_LIMIT_S" env LD_LIBRARY_PATH="$PWD/$BASELINE/lib:${LD_LIBRARY_PATH:-}" \
+    "$BASELINE/bin/gpu_pipeline" "${bench_args[@]}" --no-cpu-compare --repeats 0 || status=1
+  step "scan pipeline timing again" timing_again.log "$BENCH_LIMIT_S" "$bin/gpu_pipeline" "${bench_args[@]}" \
+    --no-cpu-compare --repeats 0 || status=1
+fi
+
 if [ "${SKIP_SANITIZERS:-0}" != 1 ]; then
   SANITIZER=$(command -v compute-sanitizer || true)
   if [ -z "$SANITIZER" ]; then
@@ -170,10 +182,17 @@ if [ "${NCU:-0}" = 1 ]; then
   if [ -z "$NCU_BIN" ]; then
     summary+=("kernel profile (ncu)         NOT FOUND")
   else
-    step "kernel profile (ncu)" ncu.log "$BENCH_LIMIT_S" bash -c "'$NCU_BIN' --clock-control none --metrics \
-      gpu__time_duration.sum --csv --page raw '$bin/gpu_pipeline' --frames $NCU_FRAMES --profile urban \
-      --no-cpu-compare --repeats 0 > '$LOGS/ncu.csv' && python3 scripts/gpu_kernel_table.py '$LOGS/ncu.csv' $NCU_FRAMES" ||
-      status=1
+    # kernel_profile NAME BIN_DIR LIBS CSV: ncu's durations of that build's kernels, per frame
+    kernel_profile() {
+      step "$1" "$4.log" "$BENCH_LIMIT_S" bash -c "LD_LIBRARY_PATH='$3' '$NCU_BIN' --clock-control none --metrics \
+        gpu__time_duration.sum --csv --page raw '$2/gpu_pipeline' --frames $NCU_FRAMES --profile urban \
+        --no-cpu-compare --repeats 0 > '$LOGS/$4.csv' && python3 scripts/gpu_kernel_table.py '$LOGS/$4.csv' $NCU_FRAMES"
+    }
+    kernel_profile "kernel profile (ncu)" "$bin" "${LD_LIBRARY_PATH:-}" ncu || status=1
+    if [ -n "${BASELINE:-}" ]; then
+      kernel_profile "baseline kernel profile (ncu)" "$BASELINE/bin" "$PWD/$BASELINE/lib:${LD_LIBRARY_PATH:-}" \
+        ncu_baseline || status=1
+    fi
   fi
 fi
 
@@ -214,6 +233,7 @@ fi
 echo "== summary =="
 printf '%s\n' "${summary[@]}" | tee "$LOGS/summary.txt"
 cat "$LOGS/timing.log" 2>/dev/null || true
+[ -n "${BASELINE:-}" ] && grep -h -A1 '^urban\|^racetrack\|^kitti\|^scans' "$LOGS/baseline_timing.log" "$LOGS/timing_again.log" 2>/dev/null
 grep -h 'agreement\|preallocates\|FAILED' "$LOGS/tests.log" || true
 grep -h 'ERROR SUMMARY\|RACECHECK SUMMARY' "$LOGS"/*check.log 2>/dev/null || true
 exit "$status"

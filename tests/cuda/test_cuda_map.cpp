@@ -163,3 +163,78 @@ TEST(CudaMap, SortsOnShortKeysOrFallBackToTheFullKeysWithTheSameMap) {
     expect_same_maps(cpu.snapshot(), gpu.map.snapshot());
   }
 }
+
+TEST(CudaMap, QueuedUpdatesReadBackInOneWaitAsTheCpuCountsThem) {
+  // insertion, removal, the points stored and the density queued, their counts read back together
+  // (as the backend's map update does); the free list they leave serves the next insertion
+  FARLIO_REQUIRE_GPU();
+  VoxelMapConfig cfg;
+  cfg.voxel_size_m = 2.0;
+  cfg.removal_radius_m = 30.0;
+  exec::CpuExecutor ex(2);
+  map::VoxelMap cpu(cfg, ex);
+  test::DeviceMapRig gpu(cfg, kVoxelCapacity);
+  const map::PointLimit asmd{30, 10.0f, 0.5f, 10};
+  const auto a = test::sample_scene(kScenePoints, 51, 0.02f);
+  const auto b = shifted(test::sample_scene(kScenePoints, 52, 0.02f), {20.0f, 3.0f, 0.0f});
+  const auto c = shifted(test::sample_scene(kScenePoints, 53, 0.02f), {45.0f, -2.0f, 0.0f});
+  const Eigen::Vector3f far_origin(40.0f, 0.0f, 0.0f);
+  constexpr double kDensityRange_m = 20.0;
+  cpu.insert(a, Eigen::Vector3f::Zero(), asmd);
+  gpu.insert(a, Eigen::Vector3f::Zero(), asmd);
+
+  const map::InsertStats sb = cpu.insert(b, far_origin, asmd);
+  const std::size_t removed = cpu.remove_far(far_origin);
+  ASSERT_GT(removed, 0u);
+  gpu.input.upload(b.data(), b.size(), gpu.executor.stream(), "DeviceMapRig::kMaxPoints");
+  gpu.map.insert_async(gpu.input.data(), b.size(), far_origin, asmd);
+  gpu.map.remove_far_async(far_origin);
+  gpu.map.num_points_async();
+  gpu.map.mean_points_per_voxel_async(far_origin, kDensityRange_m);
+  cuda::ReadBack& rb = gpu.executor.read_back();
+  rb.clear();
+  gpu.map.post(rb);
+  rb.wait();
+  const cuda::MapResults r = gpu.map.settle(rb);
+  EXPECT_EQ(r.insert.candidates, sb.candidates);
+  EXPECT_EQ(r.insert.inserted, sb.inserted);
+  EXPECT_EQ(r.insert.rejected_spacing, sb.rejected_spacing);
+  EXPECT_EQ(r.insert.rejected_full, sb.rejected_full);
+  EXPECT_EQ(r.insert.out_of_range, sb.out_of_range);
+  EXPECT_EQ(r.insert.new_voxels, sb.new_voxels);
+  EXPECT_EQ(r.insert.covariances_computed, sb.covariances_computed);
+  EXPECT_EQ(r.removed_voxels, removed);
+  EXPECT_EQ(r.points, cpu.num_points());
+  EXPECT_DOUBLE_EQ(r.mean_points_per_voxel, cpu.mean_points_per_voxel(far_origin, kDensityRange_m));
+  EXPECT_EQ(gpu.map.num_voxels(), cpu.num_voxels());
+
+  EXPECT_EQ(cpu.insert(c, far_origin, asmd).new_voxels, gpu.insert(c, far_origin, asmd).new_voxels);
+  expect_same_maps(cpu.snapshot(), gpu.map.snapshot());
+}
+
+TEST(CudaMap, AGatherBeyondItsDestinationIsACapacityErrorThatWritesNothingBeyond) {
+  FARLIO_REQUIRE_GPU();
+  test::DeviceMapRig gpu(VoxelMapConfig{}, kVoxelCapacity);
+  gpu.insert(test::sample_scene(kScenePoints, 61, 0.02f), Eigen::Vector3f::Zero(), map::PointLimit::constant(40));
+  const std::size_t stored = gpu.map.num_points();
+  ASSERT_GT(stored, 1000u);
+  const std::size_t capacity = stored / 2;
+  cuda::DeviceBuffer<Eigen::Vector4f> points(stored, "points");
+  cuda::DeviceBuffer<map::Cov3> covs(stored, "points");
+  constexpr int kAllOnes = 0xFF;  // NaN in every float: what a write would replace
+  FARLIO_CUDA_CHECK(cudaMemsetAsync(points.data(), kAllOnes, points.bytes(), gpu.executor.stream()));
+  FARLIO_CUDA_CHECK(cudaMemsetAsync(covs.data(), kAllOnes, covs.bytes(), gpu.executor.stream()));
+  try {
+    gpu.map.gather(points.data(), covs.data(), capacity, "test gather capacity");
+    FAIL() << "expected CapacityError";
+  } catch (const CapacityError& e) {
+    EXPECT_NE(std::string(e.what()).find("test gather capacity"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(std::to_string(stored)), std::string::npos) << e.what();
+  }
+  std::vector<Eigen::Vector4f> host(stored);
+  points.download(host.data(), stored, gpu.executor.stream());
+  for (std::size_t i = 0; i < stored; ++i) {
+    ASSERT_EQ(i < capacity, !host[i].array().isNaN().any()) << "point " << i << " of capacity " << capacity;
+  }
+  EXPECT_EQ(gpu.map.gather(points.data(), covs.data(), stored, "test gather capacity"), stored);
+}

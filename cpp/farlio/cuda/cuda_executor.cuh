@@ -15,31 +15,38 @@ __global__ void for_each_kernel(std::size_t n, Body body) {
   for (std::size_t i = static_cast<std::size_t>(blockIdx.x) * blockDim.x + threadIdx.x; i < n; i += stride) body(i);
 }
 
-/// Pass 1: each block reduces a grid-stride share of [0, n) into partials[blockIdx.x].
+/// Each block reduces a grid-stride share of [0, n) into partials[blockIdx.x]; the last block to
+/// finish reduces the partials, in block order, into *out and sets *blocks_done back to 0 for the
+/// next launch. The partials are reduced in the same order whichever block finishes last, so the
+/// result depends on n only.
 template <typename T, typename Map, typename Combine>
 __global__ void __launch_bounds__(CudaExecutor::kReduceThreads)
-    reduce_blocks_kernel(std::size_t n, T identity, Map map, Combine combine, T* partials) {
+    reduce_kernel(std::size_t n, T identity, Map map, Combine combine, T* partials, unsigned* blocks_done, T* out) {
   using BlockReduce = cub::BlockReduce<T, CudaExecutor::kReduceThreads>;
   __shared__ typename BlockReduce::TempStorage temp;
+  __shared__ bool last_block;
   T acc = identity;
   const std::size_t stride = static_cast<std::size_t>(gridDim.x) * blockDim.x;
   for (std::size_t i = static_cast<std::size_t>(blockIdx.x) * blockDim.x + threadIdx.x; i < n; i += stride) {
     acc = combine(acc, map(i));
   }
   const T block = BlockReduce(temp).Reduce(acc, combine);
-  if (threadIdx.x == 0) partials[blockIdx.x] = block;
-}
-
-/// Pass 2: one block reduces the partials into *out.
-template <typename T, typename Combine>
-__global__ void __launch_bounds__(CudaExecutor::kReduceThreads)
-    reduce_partials_kernel(unsigned count, T identity, Combine combine, const T* partials, T* out) {
-  using BlockReduce = cub::BlockReduce<T, CudaExecutor::kReduceThreads>;
-  __shared__ typename BlockReduce::TempStorage temp;
-  T acc = identity;
-  for (unsigned i = threadIdx.x; i < count; i += blockDim.x) acc = combine(acc, partials[i]);
-  const T total = BlockReduce(temp).Reduce(acc, combine);
-  if (threadIdx.x == 0) *out = total;
+  if (threadIdx.x == 0) {
+    partials[blockIdx.x] = block;
+    __threadfence();  // the partial is visible to every block before the count says it is done
+    last_block = atomicAdd(blocks_done, 1u) == gridDim.x - 1;
+  }
+  __syncthreads();
+  if (!last_block) return;
+  __threadfence();  // every other block's partial is read after its count
+  T total = identity;
+  for (unsigned i = threadIdx.x; i < gridDim.x; i += blockDim.x) total = combine(total, partials[i]);
+  __syncthreads();  // temp is reused
+  total = BlockReduce(temp).Reduce(total, combine);
+  if (threadIdx.x == 0) {
+    *out = total;
+    *blocks_done = 0;
+  }
 }
 
 inline unsigned blocks_for(std::size_t n, unsigned threads, unsigned max_blocks) {
@@ -58,21 +65,25 @@ void CudaExecutor::for_each(std::size_t n, const Body& body) {
 }
 
 template <typename T, typename Map, typename Combine>
-T CudaExecutor::reduce(std::size_t n, const T& identity, const Map& map, const Combine& combine) {
+void CudaExecutor::reduce_into(std::size_t n, const T& identity, const Map& map, const Combine& combine, T* out) {
   static_assert(std::is_trivially_copyable_v<T>, "reduce values are copied between host and device");
   static_assert(sizeof(T) <= kMaxReduceValueBytes, "raise CudaExecutor::kMaxReduceValueBytes");
+  // depends on n only; one block when n is 0, which writes the identity
+  const unsigned blocks = n == 0 ? 1 : detail::blocks_for(n, kReduceThreads, kMaxReduceBlocks);
+  detail::reduce_kernel<<<blocks, kReduceThreads, 0, stream_>>>(
+      n, identity, map, combine, reinterpret_cast<T*>(partials_.data()), blocks_done_.data(), out);
+  FARLIO_CUDA_CHECK(cudaGetLastError());
+}
+
+template <typename T, typename Map, typename Combine>
+T CudaExecutor::reduce(std::size_t n, const T& identity, const Map& map, const Combine& combine) {
   if (n == 0) return identity;
-  T* partials = reinterpret_cast<T*>(partials_.data());
-  T* out = partials + kMaxReduceBlocks;
-  const unsigned blocks = detail::blocks_for(n, kReduceThreads, kMaxReduceBlocks);  // depends on n only
-  detail::reduce_blocks_kernel<<<blocks, kReduceThreads, 0, stream_>>>(n, identity, map, combine, partials);
-  FARLIO_CUDA_CHECK(cudaGetLastError());
-  detail::reduce_partials_kernel<<<1, kReduceThreads, 0, stream_>>>(blocks, identity, combine, partials, out);
-  FARLIO_CUDA_CHECK(cudaGetLastError());
-  T result;
-  FARLIO_CUDA_CHECK(cudaMemcpyAsync(&result, out, sizeof(T), cudaMemcpyDeviceToHost, stream_));
-  synchronize();
-  return result;
+  T* out = reinterpret_cast<T*>(partials_.data()) + kMaxReduceBlocks;
+  reduce_into(n, identity, map, combine, out);
+  reduce_result_.clear();
+  const ReadSlot<T> slot = reduce_result_.post(out);
+  reduce_result_.wait();
+  return reduce_result_.value(slot);
 }
 
 /// The combine of sums over plain structs with operator+= (device and host).

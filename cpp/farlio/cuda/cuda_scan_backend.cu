@@ -67,6 +67,7 @@ class CudaScanBackend final : public pipeline::ScanBackend {
     config_ = config;
     map_.reconfigure(config.map);
     frame_map_.reconfigure(pipeline::frame_map_config(config));
+    map_points_ = 0;
   }
 
   std::size_t preprocess(const Scan& scan, const deskew::ScanMotion& motion, bool undistort) override {
@@ -84,41 +85,54 @@ class CudaScanBackend final : public pipeline::ScanBackend {
   }
 
   /// Crop and the keys of the downsampling cells (one thread a point), then the first point of
-  /// each cell in (cell key, input order), undistorted, as CpuScanBackend::preprocess.
+  /// each cell in (cell key, input order), undistorted, as CpuScanBackend::preprocess. The cells'
+  /// points are taken before the host reads the cell count: one thread a scan point, those past
+  /// the count (on the device) idle.
   std::size_t downsample(std::size_t n, const deskew::DeskewTable& motion, bool undistort) {
     const preprocess::PreprocessParams pp{preprocess::RangeCrop::from(config_.preprocess), motion, undistort,
                                           1.0f / map_.spacing_m()};
     const Eigen::Vector3f* raw = raw_.data();
-    const float* times = times_.data();
     std::uint64_t* keys = scratch_.keys.data();
     executor_.for_each(n, [=] __device__(std::size_t i) { keys[i] = preprocess::downsampling_key(raw[i], pp); });
-    std::size_t valid = 0;
     // the crop keeps points within max_range_m of the sensor: their cells sort on short keys
     const auto window = map::KeyWindow::around(Eigen::Vector3d::Zero(), config_.preprocess.max_range_m,
                                                static_cast<double>(pp.inv_cell_m));
-    const std::size_t kept = sort_into_groups(scratch_, executor_, algorithms_, n, &valid, window);
+    return sort_into_groups(scratch_, executor_, algorithms_, n, window,
+                            [&](ReadBack&) { take_cell_points(n, pp, undistort); })
+        .groups;
+  }
+
+  /// frame[g] = the first point of cell g, undistorted: one thread a scan point (n), those past
+  /// the cell count (on the device) idle.
+  void take_cell_points(std::size_t n, const preprocess::PreprocessParams& pp, bool undistort) {
+    const Eigen::Vector3f* raw = raw_.data();
+    const float* times = times_.data();
+    const std::int32_t* cells = scratch_.scalars.data() + kScalarGroups;
     const std::int32_t* starts = scratch_.group_start.data();
     const std::int32_t* order = scratch_.sorted_order.data();
     Eigen::Vector3f* frame = frame_.data();
-    executor_.for_each(kept, [=] __device__(std::size_t g) {
+    executor_.for_each(n, [=] __device__(std::size_t g) {
+      if (g >= static_cast<std::size_t>(*cells)) return;
       const std::int32_t i = order[starts[g]];
       frame[g] = preprocess::undistorted_point(raw[i], undistort ? times[i] : 0.0f, pp);
     });
-    return kept;
   }
 
+  /// The frame map, its points and covariances gathered into the source cloud, and the density:
+  /// the host waits for the frame map's groups, then once for the counts of all three.
   pipeline::SourceSummary build_source(double density_range_m, bool covariances) override {
     timer_.start(StageTimer::kSource);
     frame_map_.clear();
-    frame_map_.insert(frame_.data(), frame_size_, Eigen::Vector3f::Zero(),
-                      map::PointLimit::constant(config_.density.frame_map_max_points_per_voxel), points_within_m(),
-                      covariances ? map::CovarianceUpdate::Compute : map::CovarianceUpdate::Skip);
-    source_size_ =
-        frame_map_.gather(source_points_.data(), source_covs_.data(), source_points_.capacity(), kScanParameter);
-    pipeline::SourceSummary out{source_size_,
-                                frame_map_.mean_points_per_voxel(Eigen::Vector3f::Zero(), density_range_m)};
+    frame_map_.insert_async(frame_.data(), frame_size_, Eigen::Vector3f::Zero(),
+                            map::PointLimit::constant(config_.density.frame_map_max_points_per_voxel),
+                            points_within_m(),
+                            covariances ? map::CovarianceUpdate::Compute : map::CovarianceUpdate::Skip);
+    frame_map_.gather_async(source_points_.data(), source_covs_.data(), source_points_.capacity(), kScanParameter);
+    frame_map_.mean_points_per_voxel_async(Eigen::Vector3f::Zero(), density_range_m);
+    const MapResults r = read_back(frame_map_);
+    source_size_ = r.gathered_points;
     timer_.stop(StageTimer::kSource);
-    return out;
+    return {source_size_, r.mean_points_per_voxel};
   }
 
   registration::RegistrationResult register_source(const SE3& initial_guess, const registration::Thresholds& th,
@@ -149,6 +163,8 @@ class CudaScanBackend final : public pipeline::ScanBackend {
     return registration::to_linear_system(sums);
   }
 
+  /// The frame into the submap at `pose`, the far voxels out: the host waits for the groups of
+  /// the insertion, then once for the counts of the insertion, the removal and the points stored.
   map::InsertStats update_map(const SE3& pose, const map::PointLimit& limit, std::size_t* removed_voxels) override {
     timer_.start(StageTimer::kMapUpdate);
     const Eigen::Matrix3f R = pose.rotation().cast<float>();
@@ -156,11 +172,24 @@ class CudaScanBackend final : public pipeline::ScanBackend {
     const Eigen::Vector3f* frame = frame_.data();
     Eigen::Vector3f* world = world_.data();
     executor_.for_each(frame_size_, [=] __device__(std::size_t i) { world[i] = R * frame[i] + t; });
-    const map::InsertStats stats = map_.insert(world_.data(), frame_size_, t, limit, points_within_m());
-    *removed_voxels = map_.remove_far(t);
+    map_.insert_async(world_.data(), frame_size_, t, limit, points_within_m());
+    map_.remove_far_async(t);
+    map_.num_points_async();
+    const MapResults r = read_back(map_);
+    *removed_voxels = r.removed_voxels;
+    map_points_ = r.points;
     last_pose_ = pose;
     timer_.stop(StageTimer::kMapUpdate);
-    return stats;
+    return r.insert;
+  }
+
+  /// The counts that `map`'s queued work left on the device, with one wait.
+  MapResults read_back(DeviceVoxelMap& map) {
+    ReadBack& rb = executor_.read_back();
+    rb.clear();
+    map.post(rb);
+    rb.wait();
+    return map.settle(rb);
   }
 
   /// In pieces of the scan buffers' size, in input order (as the CPU backend's one insert).
@@ -171,9 +200,10 @@ class CudaScanBackend final : public pipeline::ScanBackend {
       world_.upload(world_points.data() + first, n, executor_.stream(), kScanParameter);
       map_.insert(world_.data(), n, Eigen::Vector3f::Zero(), limit);
     }
+    map_points_ = map_.num_points();
   }
   [[nodiscard]] std::size_t map_voxels() const override { return map_.num_voxels(); }
-  [[nodiscard]] std::size_t map_points() const override { return map_.num_points(); }
+  [[nodiscard]] std::size_t map_points() const override { return map_points_; }
   [[nodiscard]] map::MapSnapshot map_snapshot() const override { return map_.snapshot(); }
   [[nodiscard]] std::vector<Eigen::Vector3f> frame_points() const override {
     std::vector<Eigen::Vector3f> out(frame_size_);
@@ -250,6 +280,7 @@ class CudaScanBackend final : public pipeline::ScanBackend {
   DeviceBuffer<map::Cov3> source_covs_;
   std::size_t frame_size_ = 0;
   std::size_t source_size_ = 0;
+  std::size_t map_points_ = 0;    // in the submap after the last update (read back with it)
   std::size_t upload_bytes_ = 0;  // of the last scan (points, and times when undistorted)
   SE3 last_pose_;                 // of the last map update (the bandwidth measurement's GICP pose)
   StageTimer timer_;

@@ -46,10 +46,7 @@ std::size_t temp_bytes_for(std::size_t max_items) {
 }  // namespace
 
 DeviceAlgorithms::DeviceAlgorithms(std::size_t max_items, cudaStream_t stream)
-    : max_items_(max_items),
-      stream_(stream),
-      temp_(temp_bytes_for(max_items), "temporary bytes of CUB"),
-      count_(1, "selected counts") {}
+    : max_items_(max_items), stream_(stream), temp_(temp_bytes_for(max_items), "temporary bytes of CUB") {}
 
 void DeviceAlgorithms::require(std::size_t n, std::size_t temp_bytes) const {
   if (n > max_items_) {
@@ -69,16 +66,16 @@ void DeviceAlgorithms::sort_pairs(const std::uint64_t* keys_in, std::uint64_t* k
                                                     static_cast<int>(n), 0, key_bits, stream_));
 }
 
-std::size_t DeviceAlgorithms::select_flagged(const std::int32_t* in, const std::uint8_t* flags, std::int32_t* out,
-                                             std::size_t n) {
-  if (n == 0) return 0;
+void DeviceAlgorithms::select_flagged(const std::int32_t* in, const std::uint8_t* flags, std::int32_t* out,
+                                      std::int32_t* count, std::size_t n) {
+  if (n == 0) {
+    FARLIO_CUDA_CHECK(cudaMemsetAsync(count, 0, sizeof(std::int32_t), stream_));
+    return;
+  }
   std::size_t bytes = select_bytes(n);
   require(n, bytes);
   FARLIO_CUDA_CHECK(
-      cub::DeviceSelect::Flagged(temp_.data(), bytes, in, flags, out, count_.data(), static_cast<int>(n), stream_));
-  std::int32_t count = 0;
-  count_.download(&count, 1, stream_);
-  return static_cast<std::size_t>(count);
+      cub::DeviceSelect::Flagged(temp_.data(), bytes, in, flags, out, count, static_cast<int>(n), stream_));
 }
 
 void DeviceAlgorithms::exclusive_sum(const std::int32_t* in, std::int32_t* out, std::size_t n) {

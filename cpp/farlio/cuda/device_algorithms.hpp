@@ -20,12 +20,14 @@ class DeviceAlgorithms {
   /// the low key_bits bits of the keys are compared (one radix pass per 8 bits or so).
   void sort_pairs(const std::uint64_t* keys_in, std::uint64_t* keys_out, const std::int32_t* values_in,
                   std::int32_t* values_out, std::size_t n, int key_bits = 64);
-  /// out[0, count) = the in[i] whose flags[i] != 0, in order; returns count (waits for it).
-  std::size_t select_flagged(const std::int32_t* in, const std::uint8_t* flags, std::int32_t* out, std::size_t n);
+  /// out[0, count) = the in[i] whose flags[i] != 0, in order; *count (device memory) receives the
+  /// count. No wait: the caller reads the count back with its other results.
+  void select_flagged(const std::int32_t* in, const std::uint8_t* flags, std::int32_t* out, std::int32_t* count,
+                      std::size_t n);
   /// out[i] = in[0] + ... + in[i - 1], out[0] = 0.
   void exclusive_sum(const std::int32_t* in, std::int32_t* out, std::size_t n);
 
-  [[nodiscard]] std::size_t memory_bytes() const { return temp_.bytes() + count_.bytes(); }
+  [[nodiscard]] std::size_t memory_bytes() const { return temp_.bytes(); }
 
  private:
   void require(std::size_t n, std::size_t temp_bytes) const;
@@ -33,7 +35,6 @@ class DeviceAlgorithms {
   std::size_t max_items_;
   cudaStream_t stream_;
   DeviceBuffer<unsigned char> temp_;
-  DeviceBuffer<std::int32_t> count_;
 };
 
 }  // namespace farlio::cuda

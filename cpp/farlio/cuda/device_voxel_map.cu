@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "farlio/core/config_fields.hpp"
 #include "farlio/cuda/cuda_executor.cuh"
@@ -10,28 +11,6 @@
 namespace farlio::cuda {
 namespace {
 
-/// Sums over the voxel groups of one insertion.
-struct InsertTotals {
-  long long inserted = 0, spacing = 0, full = 0, covariances = 0, table_full = 0;
-  __host__ __device__ InsertTotals& operator+=(const InsertTotals& o) {
-    inserted += o.inserted;
-    spacing += o.spacing;
-    full += o.full;
-    covariances += o.covariances;
-    table_full += o.table_full;
-    return *this;
-  }
-};
-
-struct VoxelTotals {
-  long long voxels = 0, points = 0;
-  __host__ __device__ VoxelTotals& operator+=(const VoxelTotals& o) {
-    voxels += o.voxels;
-    points += o.points;
-    return *this;
-  }
-};
-
 std::int32_t read_scalar(const std::int32_t* device_value, cudaStream_t stream) {
   std::int32_t v = 0;
   FARLIO_CUDA_CHECK(cudaMemcpyAsync(&v, device_value, sizeof(v), cudaMemcpyDeviceToHost, stream));
@@ -40,23 +19,27 @@ std::int32_t read_scalar(const std::int32_t* device_value, cudaStream_t stream) 
 }
 
 /// Each group's stored voxel (-1 when missing) and, in key order, the rank of each missing one
-/// (an exclusive sum of the misses); returns how many are missing.
-std::size_t find_group_voxels(const map::MapView& v, MapScratch& s, CudaExecutor& ex, DeviceAlgorithms& algorithms,
-                              std::size_t groups) {
+/// (an exclusive sum of the misses): queued over the upper bound of n groups (the count is on the
+/// device, in scalars[kScalarGroups]); rank[n] receives the number of misses.
+void find_group_voxels(const map::MapView& v, MapScratch& s, CudaExecutor& ex, DeviceAlgorithms& algorithms,
+                       std::size_t n) {
   const std::uint64_t* sorted_keys = s.sorted_keys.data();
   const std::int32_t* group_start = s.group_start.data();
+  const std::int32_t* scalars = s.scalars.data();
   std::int32_t* group_voxel = s.group_voxel.data();
   std::int32_t* missing = s.missing.data();
   std::int32_t* rank = s.rank.data();
-  ex.for_each(groups, [=] __device__(std::size_t g) {
+  ex.for_each(n + 1, [=] __device__(std::size_t g) {
+    if (g >= static_cast<std::size_t>(scalars[kScalarGroups])) {
+      missing[g] = 0;  // beyond the groups: the sum stops counting
+      return;
+    }
     const std::uint64_t key = sorted_keys[group_start[g]];
     const std::int32_t vox = map::table_find(v, key, map::spatial_hash(map::unpack_key(key)));
     group_voxel[g] = vox;
     missing[g] = vox < 0 ? 1 : 0;
-    if (g == 0) missing[groups] = 0;  // one more element: rank[groups] is the number of misses
   });
-  algorithms.exclusive_sum(missing, rank, groups + 1);
-  return static_cast<std::size_t>(read_scalar(rank + groups, ex.stream()));
+  algorithms.exclusive_sum(missing, rank, n + 1);
 }
 
 /// A new voxel for each missing group, in the host's allocation order (voxel_pool.hpp), one
@@ -79,10 +62,10 @@ void add_group_voxels(const map::MapView& v, MapScratch& s, CudaExecutor& ex, st
 
 /// Inserts each voxel's candidates in order, with the cap and the spacing (one thread a voxel),
 /// and sums the groups' counts (the covariances to compute when `compute`) with the table's
-/// failed insertions.
-InsertTotals insert_groups(const map::MapView& v, MapScratch& s, CudaExecutor& ex, const Eigen::Vector3f* points,
-                           std::size_t groups, const map::InsertParams& ip, bool compute, bool refresh,
-                           const std::int32_t* table_full) {
+/// failed insertions into *totals (on the device).
+void insert_groups(const map::MapView& v, MapScratch& s, CudaExecutor& ex, const Eigen::Vector3f* points,
+                   std::size_t groups, const map::InsertParams& ip, bool compute, bool refresh,
+                   const std::int32_t* table_full, InsertTotals* totals) {
   const std::int32_t* order = s.sorted_order.data();
   const std::int32_t* group_start = s.group_start.data();
   const std::int32_t* group_voxel = s.group_voxel.data();
@@ -93,7 +76,7 @@ InsertTotals insert_groups(const map::MapView& v, MapScratch& s, CudaExecutor& e
     gstats[g] =
         map::insert_voxel_group(v, group_voxel[g], candidate, group_start[g], group_start[g + 1], ip, &first_new[g]);
   });
-  return ex.reduce(
+  ex.reduce_into(
       groups, InsertTotals{},
       [=] __device__(std::size_t g) {
         InsertTotals t;
@@ -105,7 +88,7 @@ InsertTotals insert_groups(const map::MapView& v, MapScratch& s, CudaExecutor& e
         if (g == 0) t.table_full = *table_full;
         return t;
       },
-      Add{});
+      Add{}, totals);
 }
 
 /// Covariances of the new points (or of every point of a changed voxel): one thread a point slot
@@ -145,7 +128,8 @@ DeviceVoxelMap::DeviceVoxelMap(const VoxelMapConfig& config, std::size_t voxel_c
       voxel_counts_(voxel_capacity, "voxels"),
       points_(voxel_capacity * static_cast<std::size_t>(config.max_points_per_voxel), "map points"),
       covs_(voxel_capacity * static_cast<std::size_t>(config.max_points_per_voxel), "map points"),
-      free_voxels_(voxel_capacity, "voxels") {
+      free_voxels_(voxel_capacity, "voxels"),
+      device_counts_(1, "map counts") {
   validate_config(config);
   if (voxel_capacity == 0 || voxel_capacity >= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max())) {
     throw CapacityError("CUDA backend: " + capacity_parameter_ + " must be in [1, 2^31)");
@@ -157,6 +141,8 @@ DeviceVoxelMap::DeviceVoxelMap(const VoxelMapConfig& config, std::size_t voxel_c
   // wrote (compute-sanitizer initcheck)
   FARLIO_CUDA_CHECK(cudaMemsetAsync(points_.data(), 0, points_.bytes(), executor.stream()));
   FARLIO_CUDA_CHECK(cudaMemsetAsync(covs_.data(), 0, covs_.bytes(), executor.stream()));
+  // every byte defined: post() copies the whole struct
+  FARLIO_CUDA_CHECK(cudaMemsetAsync(device_counts_.data(), 0, device_counts_.bytes(), executor.stream()));
 }
 
 void DeviceVoxelMap::reconfigure(const VoxelMapConfig& config) {
@@ -210,31 +196,39 @@ void DeviceVoxelMap::rehash() {
   used_slots_ = live_voxels_;
 }
 
-map::InsertStats DeviceVoxelMap::insert(const Eigen::Vector3f* points, std::size_t n, const Eigen::Vector3f& origin,
-                                        const map::PointLimit& limit, double within_m,
-                                        map::CovarianceUpdate covariances) {
-  map::InsertStats stats;
+void DeviceVoxelMap::insert_async(const Eigen::Vector3f* points, std::size_t n, const Eigen::Vector3f& origin,
+                                  const map::PointLimit& limit, double within_m, map::CovarianceUpdate covariances) {
+  pending_.insert = true;
+  map::InsertStats& stats = pending_.insert_stats;
+  stats = map::InsertStats{};
   stats.candidates = n;
-  if (n == 0) return stats;
+  // the device totals of an insertion that adds nothing
+  FARLIO_CUDA_CHECK(cudaMemsetAsync(&device_counts_.data()->insert, 0, sizeof(InsertTotals), executor_->stream()));
+  if (n == 0) return;
   MapScratch& s = *scratch_;
   CudaExecutor& ex = *executor_;
   s.keys.require(n + 1, "cuda.max_scan_points");
 
-  // 1. group the candidates by voxel, in input order inside a voxel
+  // 1. group the candidates by voxel, in input order inside a voxel, and find their voxels; new
+  //    ones are numbered in key order (exclusive sum of the misses). One wait for both.
   const float inv_voxel = static_cast<float>(1.0 / config_.voxel_size_m);
   std::uint64_t* keys = s.keys.data();
   ex.for_each(n, [=] __device__(std::size_t i) { keys[i] = map::point_key(points[i], inv_voxel); });
-  std::size_t valid = 0;
-  const auto window = map::KeyWindow::around(origin.cast<double>(), within_m, 1.0 / config_.voxel_size_m);
-  const std::size_t groups = sort_into_groups(s, ex, *algorithms_, n, &valid, window);
-  stats.out_of_range = n - valid;
-  if (groups == 0) return stats;
-
-  // 2. find existing voxels; new ones are numbered in key order (exclusive sum of the misses)
   const map::MapView v = view();
-  const std::size_t new_voxels = find_group_voxels(v, s, ex, *algorithms_, groups);
-  FARLIO_CUDA_CHECK(cudaMemsetAsync(s.scalars.data(), 0, s.scalars.bytes(), ex.stream()));
+  ReadSlot<std::int32_t> misses;
+  const auto window = map::KeyWindow::around(origin.cast<double>(), within_m, 1.0 / config_.voxel_size_m);
+  const SortedGroups sorted = sort_into_groups(s, ex, *algorithms_, n, window, [&](ReadBack& rb) {
+    find_group_voxels(v, s, ex, *algorithms_, n);
+    misses = rb.post(s.rank.data() + n);
+  });
+  const std::size_t groups = sorted.groups;
+  stats.out_of_range = n - sorted.valid;
+  if (groups == 0) return;
+  const auto new_voxels = static_cast<std::size_t>(ex.read_back().value(misses));
+
+  // 2. the new voxels take their slots
   std::int32_t* table_full = s.scalars.data() + kScalarTableFull;
+  FARLIO_CUDA_CHECK(cudaMemsetAsync(table_full, 0, sizeof(std::int32_t), ex.stream()));
   if (new_voxels > 0) {
     const map::InsertionPlan plan = map::plan_insertion(counts(), new_voxels, capacity_, capacity_parameter_);
     if (plan.rehash_slots > 0) {  // the device table has its one size: drop the erased slots in place
@@ -255,22 +249,22 @@ map::InsertStats DeviceVoxelMap::insert(const Eigen::Vector3f* points, std::size
   const bool refresh = config_.refresh_covariances;
   const bool compute = covariances == map::CovarianceUpdate::Compute;
   const map::InsertParams ip{origin, limit, spacing_m_ * spacing_m_};
-  const InsertTotals totals = insert_groups(v, s, ex, points, groups, ip, compute, refresh, table_full);
-  if (totals.table_full > 0) {
-    throw CapacityError("CUDA backend: the voxel table is full; raise " + capacity_parameter_);
-  }
-  stats.inserted = static_cast<std::size_t>(totals.inserted);
-  stats.rejected_spacing = static_cast<std::size_t>(totals.spacing);
-  stats.rejected_full = static_cast<std::size_t>(totals.full);
-  stats.covariances_computed = static_cast<std::size_t>(totals.covariances);
+  insert_groups(v, s, ex, points, groups, ip, compute, refresh, table_full, &device_counts_.data()->insert);
 
   // 4. covariances of the new points (or of every point of a changed voxel)
-  if (totals.covariances > 0) update_group_covariances(v, s, ex, groups, config_, refresh);
-  return stats;
+  if (compute) update_group_covariances(v, s, ex, groups, config_, refresh);
 }
 
-std::size_t DeviceVoxelMap::remove_far(const Eigen::Vector3f& origin) {
-  if (!map::removal_applies(config_, high_water_)) return 0;
+map::InsertStats DeviceVoxelMap::insert(const Eigen::Vector3f* points, std::size_t n, const Eigen::Vector3f& origin,
+                                        const map::PointLimit& limit, double within_m,
+                                        map::CovarianceUpdate covariances) {
+  insert_async(points, n, origin, limit, within_m, covariances);
+  return read_results().insert;
+}
+
+void DeviceVoxelMap::remove_far_async(const Eigen::Vector3f& origin) {
+  if (!map::removal_applies(config_, high_water_)) return;
+  pending_.removal = true;
   const double r2 = config_.removal_radius_m * config_.removal_radius_m;
   const double vs = config_.voxel_size_m;
   const Eigen::Vector3d o = origin.cast<double>();
@@ -286,19 +280,21 @@ std::size_t DeviceVoxelMap::remove_far(const Eigen::Vector3f& origin) {
     v.voxel_counts[i] = 0;
   });
   // freed voxels join the free list in increasing order, as on the CPU
-  const std::size_t removed =
-      algorithms_->select_flagged(scratch_->iota.data(), flags, free_voxels_.data() + free_count_, high_water_);
-  free_count_ += removed;
-  live_voxels_ -= removed;
-  if (map::rehash_after_removal(counts())) rehash();
-  return removed;
+  algorithms_->select_flagged(scratch_->iota.data(), flags, free_voxels_.data() + free_count_,
+                              &device_counts_.data()->removed, high_water_);
 }
 
-double DeviceVoxelMap::mean_points_per_voxel(const Eigen::Vector3f& origin, double range_m) const {
+std::size_t DeviceVoxelMap::remove_far(const Eigen::Vector3f& origin) {
+  remove_far_async(origin);
+  return read_results().removed_voxels;
+}
+
+void DeviceVoxelMap::mean_points_per_voxel_async(const Eigen::Vector3f& origin, double range_m) {
+  pending_.mean = true;
   const map::ConstMapView v = view();
   const double vs = config_.voxel_size_m;
   const Eigen::Vector3d o = origin.cast<double>();
-  const VoxelTotals t = executor_->reduce(
+  executor_->reduce_into(
       high_water_, VoxelTotals{},
       [=] __device__(std::size_t i) {
         VoxelTotals r;
@@ -308,8 +304,20 @@ double DeviceVoxelMap::mean_points_per_voxel(const Eigen::Vector3f& origin, doub
         r.points = v.voxel_counts[i];
         return r;
       },
-      Add{});
-  return t.voxels ? static_cast<double>(t.points) / static_cast<double>(t.voxels) : 0.0;
+      Add{}, &device_counts_.data()->near);
+}
+
+double DeviceVoxelMap::mean_points_per_voxel(const Eigen::Vector3f& origin, double range_m) {
+  mean_points_per_voxel_async(origin, range_m);
+  return read_results().mean_points_per_voxel;
+}
+
+void DeviceVoxelMap::num_points_async() {
+  pending_.points = true;
+  const std::int32_t* counts = voxel_counts_.data();
+  executor_->reduce_into(
+      high_water_, 0LL, [=] __device__(std::size_t i) { return static_cast<long long>(counts[i]); }, Add{},
+      &device_counts_.data()->points);
 }
 
 std::size_t DeviceVoxelMap::num_points() const {
@@ -318,28 +326,83 @@ std::size_t DeviceVoxelMap::num_points() const {
       high_water_, 0LL, [=] __device__(std::size_t i) { return static_cast<long long>(counts[i]); }, Add{}));
 }
 
-std::size_t DeviceVoxelMap::gather(Eigen::Vector4f* out_points, map::Cov3* out_covs, std::size_t capacity,
-                                   const char* parameter) {
-  if (high_water_ == 0) return 0;
+void DeviceVoxelMap::gather_async(Eigen::Vector4f* out_points, map::Cov3* out_covs, std::size_t capacity,
+                                  const char* parameter) {
+  pending_.gather = true;
+  pending_.gather_capacity = capacity;
+  pending_.gather_parameter = parameter;
+  std::int32_t* gathered = &device_counts_.data()->gathered;
+  if (high_water_ == 0) {
+    FARLIO_CUDA_CHECK(cudaMemsetAsync(gathered, 0, sizeof(std::int32_t), executor_->stream()));
+    return;
+  }
   const map::ConstMapView v = view();
   std::int32_t* counts = scratch_->missing.data();
   std::int32_t* offsets = scratch_->rank.data();
   const std::size_t hw = high_water_;
   executor_->for_each(hw + 1, [=] __device__(std::size_t i) { counts[i] = i < hw ? v.voxel_counts[i] : 0; });
   algorithms_->exclusive_sum(counts, offsets, hw + 1);
-  const auto total = static_cast<std::size_t>(read_scalar(offsets + hw, executor_->stream()));
-  if (total > capacity) {
-    throw CapacityError("CUDA backend: " + std::to_string(total) + " source points exceed the device buffer of " +
-                        std::to_string(capacity) + "; raise " + parameter);
-  }
+  // the total is known on the device only: no point is written beyond the capacity
+  const auto limit = static_cast<std::int64_t>(capacity);
   executor_->for_each(hw, [=] __device__(std::size_t i) {
+    if (i == 0) *gathered = offsets[hw];
     const auto vox = static_cast<std::int32_t>(i);
-    for (std::int32_t j = 0; j < v.voxel_counts[i]; ++j) {
+    for (std::int32_t j = 0; j < v.voxel_counts[i] && offsets[i] + j < limit; ++j) {
       out_points[offsets[i] + j] = v.points[v.point_index(vox, j)];
       out_covs[offsets[i] + j] = v.covs[v.point_index(vox, j)];
     }
   });
-  return total;
+}
+
+std::size_t DeviceVoxelMap::gather(Eigen::Vector4f* out_points, map::Cov3* out_covs, std::size_t capacity,
+                                   const char* parameter) {
+  gather_async(out_points, out_covs, capacity, parameter);
+  return read_results().gathered_points;
+}
+
+void DeviceVoxelMap::post(ReadBack& read_back) { pending_.slot = read_back.post(device_counts_.data()); }
+
+MapResults DeviceVoxelMap::settle(const ReadBack& read_back) {
+  const Pending done = std::exchange(pending_, Pending{});
+  const DeviceMapCounts c = read_back.value(done.slot);
+  MapResults r;
+  if (done.insert) {
+    if (c.insert.table_full > 0) {
+      throw CapacityError("CUDA backend: the voxel table is full; raise " + capacity_parameter_);
+    }
+    r.insert = done.insert_stats;
+    r.insert.inserted = static_cast<std::size_t>(c.insert.inserted);
+    r.insert.rejected_spacing = static_cast<std::size_t>(c.insert.spacing);
+    r.insert.rejected_full = static_cast<std::size_t>(c.insert.full);
+    r.insert.covariances_computed = static_cast<std::size_t>(c.insert.covariances);
+  }
+  if (done.removal) {
+    r.removed_voxels = static_cast<std::size_t>(c.removed);
+    free_count_ += r.removed_voxels;
+    live_voxels_ -= r.removed_voxels;
+    if (map::rehash_after_removal(counts())) rehash();
+  }
+  if (done.gather) {
+    r.gathered_points = static_cast<std::size_t>(c.gathered);
+    if (r.gathered_points > done.gather_capacity) {
+      throw CapacityError("CUDA backend: " + std::to_string(r.gathered_points) +
+                          " source points exceed the device buffer of " + std::to_string(done.gather_capacity) +
+                          "; raise " + done.gather_parameter);
+    }
+  }
+  if (done.mean && c.near.voxels > 0) {
+    r.mean_points_per_voxel = static_cast<double>(c.near.points) / static_cast<double>(c.near.voxels);
+  }
+  if (done.points) r.points = static_cast<std::size_t>(c.points);
+  return r;
+}
+
+MapResults DeviceVoxelMap::read_results() {
+  ReadBack& rb = executor_->read_back();
+  rb.clear();
+  post(rb);
+  rb.wait();
+  return settle(rb);
 }
 
 std::size_t DeviceVoxelMap::memory_bytes() const {

@@ -1,3 +1,5 @@
+#include <utility>
+
 #include "farlio/cuda/cuda_executor.cuh"
 #include "farlio/cuda/map_scratch.hpp"
 
@@ -37,11 +39,12 @@ std::size_t MapScratch::memory_bytes() const {
          group_stats.bytes() + scalars.bytes();
 }
 
-std::size_t sort_into_groups(MapScratch& s, CudaExecutor& ex, DeviceAlgorithms& alg, std::size_t n, std::size_t* valid,
-                             const map::KeyWindow& window) {
-  *valid = 0;
-  if (n == 0) return 0;
-  s.keys.require(n + 1, "cuda.max_scan_points");  // + 1: the end of the last group
+namespace {
+
+/// Sorts the keys (short or full) and flags each group's first sorted key; the sorted full keys
+/// end in s.sorted_keys. Queued, no wait.
+void sort_and_flag(MapScratch& s, CudaExecutor& ex, DeviceAlgorithms& alg, std::size_t n,
+                   const map::KeyWindow& window) {
   std::int32_t* scalars = s.scalars.data();
   const bool short_sort = window.usable();
   if (short_sort) {
@@ -59,7 +62,9 @@ std::size_t sort_into_groups(MapScratch& s, CudaExecutor& ex, DeviceAlgorithms& 
   } else {
     alg.sort_pairs(s.keys.data(), s.sorted_keys.data(), s.iota.data(), s.sorted_order.data(), n);
   }
-  std::uint64_t* keys = s.sorted_keys.data();
+  const std::uint64_t* keys = s.sorted_keys.data();
+  // the sorted short keys expand into short_keys, which then takes the name sorted_keys
+  std::uint64_t* expanded = short_sort ? s.short_keys.data() : nullptr;
   std::uint8_t* flags = s.flags.data();
   const std::uint64_t empty_key = short_sort ? window.empty_short_key() : map::kEmptyKey;
   ex.for_each(n, [=] __device__(std::size_t i) {
@@ -69,18 +74,32 @@ std::size_t sort_into_groups(MapScratch& s, CudaExecutor& ex, DeviceAlgorithms& 
     // exactly one thread writes where the valid keys end (empty keys sort last)
     if (empty && (i == 0 || keys[i - 1] != empty_key)) scalars[kScalarFirstEmpty] = static_cast<std::int32_t>(i);
     if (!empty && i == n - 1) scalars[kScalarFirstEmpty] = static_cast<std::int32_t>(n);
+    if (expanded) expanded[i] = window.expand(k);
   });
-  if (short_sort) ex.for_each(n, [=] __device__(std::size_t i) { keys[i] = window.expand(keys[i]); });
-  const std::size_t groups = alg.select_flagged(s.iota.data(), flags, s.group_start.data(), n);
-  std::int32_t found[kScalarCount] = {};
-  FARLIO_CUDA_CHECK(cudaMemcpyAsync(found, scalars, sizeof(found), cudaMemcpyDeviceToHost, ex.stream()));
-  ex.synchronize();
-  if (short_sort && found[kScalarOutsideWindow] != 0) return sort_into_groups(s, ex, alg, n, valid);
-  const std::int32_t first_empty = found[kScalarFirstEmpty];
-  *valid = static_cast<std::size_t>(first_empty);
+  if (short_sort) std::swap(s.sorted_keys, s.short_keys);
+}
+
+}  // namespace
+
+SortedGroups sort_into_groups(MapScratch& s, CudaExecutor& ex, DeviceAlgorithms& alg, std::size_t n,
+                              const map::KeyWindow& window, const AfterSort& after_sort) {
+  if (n == 0) return {};
+  s.keys.require(n + 1, "cuda.max_scan_points");  // + 1: the end of the last group
+  sort_and_flag(s, ex, alg, n, window);
+  std::int32_t* scalars = s.scalars.data();
+  alg.select_flagged(s.iota.data(), s.flags.data(), s.group_start.data(), scalars + kScalarGroups, n);
   std::int32_t* starts = s.group_start.data();
-  ex.for_each(1, [=] __device__(std::size_t) { starts[groups] = first_empty; });
-  return groups;
+  ex.for_each(1, [=] __device__(std::size_t) { starts[scalars[kScalarGroups]] = scalars[kScalarFirstEmpty]; });
+  ReadBack& rb = ex.read_back();
+  rb.clear();
+  if (after_sort) after_sort(rb);
+  const ReadSlot<std::int32_t> found = rb.post(scalars, kScalarCount);
+  rb.wait();
+  if (window.usable() && rb.value(found, kScalarOutsideWindow) != 0) {
+    return sort_into_groups(s, ex, alg, n, map::KeyWindow{}, after_sort);
+  }
+  return {static_cast<std::size_t>(rb.value(found, kScalarGroups)),
+          static_cast<std::size_t>(rb.value(found, kScalarFirstEmpty))};
 }
 
 }  // namespace farlio::cuda
