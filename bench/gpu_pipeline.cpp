@@ -126,6 +126,7 @@ double device_used_bytes() {
 
 struct Run {
   std::vector<double> total_ms, stage_ms[kStages];
+  std::vector<double> between_ms;  // the frame's time outside its four stages
   std::vector<SE3> poses;
   double prealloc_bytes = 0.0, used_bytes = 0.0;
   std::size_t max_voxels = 0;
@@ -140,7 +141,12 @@ Run run(pipeline::ScanPipeline& p, const std::vector<Scan>& scans, double used_b
     r.total_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     const double st[kStages] = {f.timings.preprocess_s, f.timings.covariance_s, f.timings.registration_s,
                                 f.timings.map_update_s};
-    for (int k = 0; k < kStages; ++k) r.stage_ms[k].push_back(st[k] * kMsPerS);
+    double between = r.total_ms.back();
+    for (int k = 0; k < kStages; ++k) {
+      r.stage_ms[k].push_back(st[k] * kMsPerS);
+      between -= st[k] * kMsPerS;
+    }
+    r.between_ms.push_back(between);
     r.poses.push_back(f.pose);
     r.max_voxels = std::max(r.max_voxels, f.map_voxels);
     r.device_timed = f.timings.device_timed;
@@ -157,7 +163,7 @@ void print_row(const std::string& name, double points, Device device, const Run&
   std::printf("    stages (%s), median / p99 ms:", r.device_timed ? "CUDA events" : "wall clock");
   for (int k = 0; k < kStages; ++k)
     std::printf("  %s %.3f / %.3f", kStageNames[k], quantile(r.stage_ms[k], kMedian), quantile(r.stage_ms[k], kP99));
-  std::printf("\n");
+  std::printf("  between %.3f / %.3f\n", quantile(r.between_ms, kMedian), quantile(r.between_ms, kP99));
 }
 
 void print_bandwidth(pipeline::ScanPipeline& p, int repeats, double frame_median_ms) {

@@ -208,9 +208,10 @@ TEST(SharedBodies, FactorsAddedInPlaceEqualTheReduceOfPerPointSums) {
   }
 }
 
-TEST(SharedBodies, PerVoxelCovariancesEqualThePerPointBodyOfCuda) {
-  // the CPU computes a voxel's covariances with its 27 neighbours looked up once, CUDA one
-  // point a thread with its own lookups: bit-identical covariances and shapes
+TEST(SharedBodies, CovariancesFromTheNeighbourhoodLookedUpOnceEqualThoseOfEachPointsOwnLookups) {
+  // both backends compute a voxel's covariances with its 27 neighbours looked up once (the CPU a
+  // voxel a task, CUDA a point a lane); each point's own lookups (knn_search without the
+  // neighbourhood, as the registration searches) give bit-identical covariances and shapes
   exec::CpuExecutor ex(2);
   VoxelMapConfig cfg;
   cfg.max_points_per_voxel = 20;
@@ -221,9 +222,12 @@ TEST(SharedBodies, PerVoxelCovariancesEqualThePerPointBodyOfCuda) {
   std::size_t compared = 0, with_covariance = 0;
   for (std::size_t vox = 0; vox < cpu.voxel_keys.size(); ++vox) {
     for (std::int32_t j = 0; j < cpu.voxel_counts[vox]; ++j) {
-      map::update_point_covariance(v, static_cast<std::int32_t>(vox), j, cfg.covariance_neighbors,
-                                   static_cast<float>(cfg.covariance_epsilon),
-                                   static_cast<float>(cfg.line_eigenvalue_ratio));
+      const int neighbors = cfg.covariance_neighbors;
+      map::point_covariance(v, static_cast<std::int32_t>(vox), j, neighbors, static_cast<float>(cfg.covariance_epsilon),
+                            static_cast<float>(cfg.line_eigenvalue_ratio),
+                            [&](const Eigen::Vector3f& p, std::int64_t* idx, float* d2) {
+                              return map::knn_search(v, p, neighbors, map::kUnboundedDistance2, idx, d2);
+                            });
       const std::int64_t i = v.point_index(static_cast<std::int32_t>(vox), j);
       const auto k = static_cast<std::size_t>(i);
       ASSERT_EQ(v.points[i].w(), cpu.points[k].w()) << "voxel " << vox << " point " << j;

@@ -19,8 +19,8 @@ namespace {
 constexpr std::size_t kBlockItems = gpu::CudaExecutor::kReduceThreads;
 constexpr std::size_t kGridItems = kBlockItems * gpu::CudaExecutor::kMaxReduceBlocks;
 // sizes around one block, one full grid (the last block count) and beyond (grid-stride)
-const std::vector<std::size_t> kSizes = {0,          1,          kBlockItems - 1, kBlockItems, kBlockItems + 1,
-                                         kGridItems - 1, kGridItems, kGridItems + 1,  1000003};
+const std::vector<std::size_t> kSizes = {
+    0, 1, kBlockItems - 1, kBlockItems, kBlockItems + 1, kGridItems - 1, kGridItems, kGridItems + 1, 1000003};
 
 long long gauss_sum(std::size_t n) { return static_cast<long long>(n) * (static_cast<long long>(n) - 1) / 2; }
 

@@ -111,9 +111,10 @@ TEST(CudaPipeline, FewFramesRunEveryKernel) {
 
 TEST(CudaPipeline, EmptyTinyAndNonFiniteScansGoAsOnTheCpu) {
   // bad input on the device path: an empty scan, three points, and a scan with half its points
-  // NaN or infinite, among good scans; the same outcome as the CPU's, no device error
+  // NaN or infinite and some of the others with a NaN time, among good scans; the same outcome as
+  // the CPU's (the GPU drops and counts the non-finite points itself), no device error
   FARLIO_REQUIRE_GPU();
-  constexpr std::size_t kGood = 10, kEmpty = 3, kTiny = 5, kNonFinite = 7, kTinyPoints = 3;
+  constexpr std::size_t kGood = 10, kEmpty = 3, kTiny = 5, kNonFinite = 7, kTinyPoints = 3, kNanTimeEvery = 8;
   constexpr double kMaxPoseDiff_m = 0.01;
   sim::SimConfig sc = sim::default_config(sim::Profile::Urban);
   sc.duration_s = 0.1 * static_cast<double>(kSkipAtRest + kGood + 1);
@@ -131,6 +132,7 @@ TEST(CudaPipeline, EmptyTinyAndNonFiniteScansGoAsOnTheCpu) {
       scan = test::thinned(scan, scan.size() / kTinyPoints);
     } else if (k == kNonFinite) {
       for (std::size_t i = 0; i < scan.size(); i += 2) scan.points[i] = Eigen::Vector3f(nan, 1.0f, inf);
+      for (std::size_t i = 1; i < scan.size(); i += kNanTimeEvery) scan.time_s[i] = nan;
     }
     const auto rc = cpu.process(scan);
     const auto rg = gpu.process(scan);
@@ -139,7 +141,10 @@ TEST(CudaPipeline, EmptyTinyAndNonFiniteScansGoAsOnTheCpu) {
     EXPECT_EQ(rc.failure.empty(), !bad) << rc.failure;  // the CPU's verdict: what the GPU must match
     if (k == kNonFinite) {
       EXPECT_TRUE(rc.registered);  // half of it is a good scan
+      const std::size_t n = scan.size();
+      EXPECT_EQ(rc.non_finite_points, (n + 1) / 2 + (n - 1 + kNanTimeEvery - 1) / kNanTimeEvery);
     }
+    EXPECT_EQ(rc.non_finite_points, rg.non_finite_points);
     EXPECT_EQ(rc.registered, rg.registered);
     EXPECT_EQ(rc.failure, rg.failure);
     // libdevice's sin/cos in the undistortion may move a point into a neighbouring cell

@@ -8,6 +8,8 @@
 #include "farlio/cuda/device_voxel_map.hpp"
 #include "farlio/cuda/map_scratch.hpp"
 #include "farlio/cuda/stage_timer.hpp"
+#include "farlio/cuda/staged_upload.hpp"
+#include "farlio/exec/atomics.hpp"
 #include "farlio/map/voxel_update.hpp"
 #include "farlio/preprocess/preprocess_point.hpp"
 #include "farlio/registration/factor_sums.hpp"
@@ -57,6 +59,8 @@ class CudaScanBackend final : public pipeline::ScanBackend {
         world_(max_points_, "scan points"),
         source_points_(max_points_, "source points"),
         source_covs_(max_points_, "source points"),
+        dropped_(1, "non-finite point counts"),
+        staging_(max_points_ * (sizeof(Eigen::Vector3f) + sizeof(float)), config.num_threads),
         timer_(executor_.stream()) {
     executor_.synchronize();  // the buffers' initialisation has run
   }
@@ -74,32 +78,55 @@ class CudaScanBackend final : public pipeline::ScanBackend {
     timer_.new_frame();
     timer_.start(StageTimer::kPreprocess);
     const std::size_t n = scan.size();
-    upload_bytes_ = n * (sizeof(Eigen::Vector3f) + (undistort ? sizeof(float) : 0));
-    raw_.upload(scan.points.data(), n, executor_.stream(), kScanParameter);
-    if (undistort) times_.upload(scan.time_s.data(), n, executor_.stream(), kScanParameter);
-    frame_size_ =
-        n == 0 ? 0
-               : downsample(n, deskew::DeskewTable::sample(motion, static_cast<float>(scan.duration_s())), undistort);
+    // the times go up whenever the scan has them: a point with a non-finite time is dropped too
+    const bool times = scan.has_time();
+    upload_bytes_ = n * (sizeof(Eigen::Vector3f) + (times ? sizeof(float) : 0));
+    raw_.require(n, kScanParameter);
+    staging_.begin_frame();
+    staging_.upload(scan.points.data(), raw_.data(), n * sizeof(Eigen::Vector3f), executor_.stream());
+    if (times) staging_.upload(scan.time_s.data(), times_.data(), n * sizeof(float), executor_.stream());
+    non_finite_points_ = 0;
+    frame_size_ = n == 0 ? 0
+                         : downsample(n, deskew::DeskewTable::sample(motion, static_cast<float>(scan.duration_s())),
+                                      undistort, times);
     timer_.stop(StageTimer::kPreprocess);
     return frame_size_;
   }
 
-  /// Crop and the keys of the downsampling cells (one thread a point), then the first point of
-  /// each cell in (cell key, input order), undistorted, as CpuScanBackend::preprocess. The cells'
-  /// points are taken before the host reads the cell count: one thread a scan point, those past
-  /// the count (on the device) idle.
-  std::size_t downsample(std::size_t n, const deskew::DeskewTable& motion, bool undistort) {
+  [[nodiscard]] bool screens_non_finite_points() const override { return true; }
+  [[nodiscard]] std::size_t non_finite_points() const override { return non_finite_points_; }
+
+  /// Non-finite points dropped and counted, the crop and the keys of the downsampling cells (one
+  /// thread a point), then the first point of each cell in (cell key, input order), undistorted,
+  /// as CpuScanBackend::preprocess on the scan without its non-finite points. The cells' points
+  /// are taken before the host reads the cell count: one thread a scan point, those past the
+  /// count (on the device) idle.
+  std::size_t downsample(std::size_t n, const deskew::DeskewTable& motion, bool undistort, bool times) {
     const preprocess::PreprocessParams pp{preprocess::RangeCrop::from(config_.preprocess), motion, undistort,
                                           1.0f / map_.spacing_m()};
     const Eigen::Vector3f* raw = raw_.data();
+    const float* time = times ? times_.data() : nullptr;
     std::uint64_t* keys = scratch_.keys.data();
-    executor_.for_each(n, [=] __device__(std::size_t i) { keys[i] = preprocess::downsampling_key(raw[i], pp); });
+    std::int32_t* dropped = dropped_.data();
+    FARLIO_CUDA_CHECK(cudaMemsetAsync(dropped, 0, sizeof(std::int32_t), executor_.stream()));
+    executor_.for_each(n, [=] __device__(std::size_t i) {
+      if (!preprocess::finite_point(raw[i], time ? time + i : nullptr)) {
+        keys[i] = map::kEmptyKey;
+        exec::atomic_add(dropped, 1);
+        return;
+      }
+      keys[i] = preprocess::downsampling_key(raw[i], pp);
+    });
     // the crop keeps points within max_range_m of the sensor: their cells sort on short keys
     const auto window = map::KeyWindow::around(Eigen::Vector3d::Zero(), config_.preprocess.max_range_m,
                                                static_cast<double>(pp.inv_cell_m));
-    return sort_into_groups(scratch_, executor_, algorithms_, n, window,
-                            [&](ReadBack&) { take_cell_points(n, pp, undistort); })
-        .groups;
+    ReadSlot<std::int32_t> non_finite;
+    const std::size_t cells = sort_into_groups(scratch_, executor_, algorithms_, n, window, [&](ReadBack& rb) {
+                                take_cell_points(n, pp, undistort);
+                                non_finite = rb.post(dropped_.data());
+                              }).groups;
+    non_finite_points_ = static_cast<std::size_t>(executor_.read_back().value(non_finite));
+    return cells;
   }
 
   /// frame[g] = the first point of cell g, undistorted: one thread a scan point (n), those past
@@ -214,7 +241,7 @@ class CudaScanBackend final : public pipeline::ScanBackend {
   [[nodiscard]] std::size_t memory_bytes() const override {
     return executor_.memory_bytes() + algorithms_.memory_bytes() + scratch_.memory_bytes() + map_.memory_bytes() +
            frame_map_.memory_bytes() + raw_.bytes() + times_.bytes() + frame_.bytes() + world_.bytes() +
-           source_points_.bytes() + source_covs_.bytes();
+           source_points_.bytes() + source_covs_.bytes() + dropped_.bytes();
   }
 
   bool device_stage_times(pipeline::FrameTimings& t) override {
@@ -228,7 +255,7 @@ class CudaScanBackend final : public pipeline::ScanBackend {
 
   std::vector<BandwidthSample> measure_bandwidth(int repeats) {
     std::vector<BandwidthSample> out{measure_copy(executor_, kCopyBytes, repeats)};
-    if (upload_bytes_ > 0) out.push_back(measure_upload(executor_, upload_bytes_, repeats));
+    if (upload_bytes_ > 0) out.push_back(measure_upload(executor_, staging_, upload_bytes_, repeats));
     const std::size_t n = map_.num_points();
     DeviceBuffer<Eigen::Vector4f> points(n, "map points");
     DeviceBuffer<map::Cov3> covs(n, "map points");
@@ -278,9 +305,12 @@ class CudaScanBackend final : public pipeline::ScanBackend {
   DeviceBuffer<Eigen::Vector3f> world_;
   DeviceBuffer<Eigen::Vector4f> source_points_;
   DeviceBuffer<map::Cov3> source_covs_;
+  DeviceBuffer<std::int32_t> dropped_;  // non-finite points of the last scan
+  StagedUpload staging_;                // the scan's way to the device
   std::size_t frame_size_ = 0;
   std::size_t source_size_ = 0;
-  std::size_t map_points_ = 0;    // in the submap after the last update (read back with it)
+  std::size_t map_points_ = 0;  // in the submap after the last update (read back with it)
+  std::size_t non_finite_points_ = 0;
   std::size_t upload_bytes_ = 0;  // of the last scan (points, and times when undistorted)
   SE3 last_pose_;                 // of the last map update (the bandwidth measurement's GICP pose)
   StageTimer timer_;

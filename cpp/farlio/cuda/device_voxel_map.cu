@@ -60,19 +60,24 @@ void add_group_voxels(const map::MapView& v, MapScratch& s, CudaExecutor& ex, st
   });
 }
 
-/// Inserts each voxel's candidates in order, with the cap and the spacing (one thread a voxel),
+/// Inserts each voxel's candidates in order, with the cap and the spacing (one thread a voxel;
+/// `candidates`: the sorted ones that have a voxel, the groups' points),
 /// and sums the groups' counts (the covariances to compute when `compute`) with the table's
 /// failed insertions into *totals (on the device).
 void insert_groups(const map::MapView& v, MapScratch& s, CudaExecutor& ex, const Eigen::Vector3f* points,
-                   std::size_t groups, const map::InsertParams& ip, bool compute, bool refresh,
+                   std::size_t candidates, std::size_t groups, const map::InsertParams& ip, bool compute, bool refresh,
                    const std::int32_t* table_full, InsertTotals* totals) {
   const std::int32_t* order = s.sorted_order.data();
   const std::int32_t* group_start = s.group_start.data();
   const std::int32_t* group_voxel = s.group_voxel.data();
   std::int32_t* first_new = s.first_new.data();
   map::GroupStats* gstats = s.group_stats.data();
+  // the candidates in sorted order first, one thread each: a group's thread then reads its
+  // candidates one after the other from contiguous memory, not from all over the input
+  Eigen::Vector3f* sorted = s.sorted_points.data();
+  ex.for_each(candidates, [=] __device__(std::size_t c) { sorted[c] = points[order[c]]; });
   ex.for_each(groups, [=] __device__(std::size_t g) {
-    const auto candidate = [=](std::int64_t c) { return points[order[c]]; };
+    const auto candidate = [=](std::int64_t c) { return sorted[c]; };
     gstats[g] =
         map::insert_voxel_group(v, group_voxel[g], candidate, group_start[g], group_start[g + 1], ip, &first_new[g]);
   });
@@ -91,24 +96,45 @@ void insert_groups(const map::MapView& v, MapScratch& s, CudaExecutor& ex, const
       Add{}, totals);
 }
 
-/// Covariances of the new points (or of every point of a changed voxel): one thread a point slot
-/// of each group's voxel (the CPU runs the same body in a loop, one task a voxel).
-void update_group_covariances(const map::MapView& v, MapScratch& s, CudaExecutor& ex, std::size_t groups,
-                              const VoxelMapConfig& config, bool refresh) {
-  const std::int32_t* group_voxel = s.group_voxel.data();
-  const std::int32_t* first_new = s.first_new.data();
-  const int k = config.covariance_neighbors;
-  const auto eps = static_cast<float>(config.covariance_epsilon);
-  const auto line_ratio = static_cast<float>(config.line_eigenvalue_ratio);
-  const auto slots = static_cast<std::size_t>(config.max_points_per_voxel);
-  ex.for_each(groups * slots, [=] __device__(std::size_t i) {
-    const std::size_t g = i / slots;
-    const auto j = static_cast<std::int32_t>(i % slots);
+constexpr unsigned kWarpLanes = 32;
+constexpr unsigned kCovarianceWarps = 4;  // a block's warps: a group each
+constexpr std::size_t kMaxCovarianceBlocks = 65535;
+
+/// Covariances of the new points (or of every point of a changed voxel): one warp a group. Its
+/// lanes look up the 27 voxels around the group's voxel together, then each lane computes a
+/// point's covariance from them (map::update_point_covariance; the CPU runs the same body in a
+/// loop over the voxel's points, one task a voxel).
+__global__ void __launch_bounds__(kCovarianceWarps* kWarpLanes)
+    group_covariance_kernel(map::MapView v, const std::int32_t* group_voxel, const std::int32_t* first_new,
+                            std::size_t groups, int k, float eps, float line_ratio, bool refresh) {
+  __shared__ std::int32_t found[kCovarianceWarps][map::kNeighborVoxels];
+  const unsigned lane = threadIdx.x % kWarpLanes, warp = threadIdx.x / kWarpLanes;
+  const std::size_t stride = static_cast<std::size_t>(gridDim.x) * kCovarianceWarps;
+  for (std::size_t g = static_cast<std::size_t>(blockIdx.x) * kCovarianceWarps + warp; g < groups; g += stride) {
     const std::int32_t vox = group_voxel[g];
     const map::PointRange r = map::covariance_points(v.voxel_counts[vox], first_new[g], refresh);
-    if (j < r.begin || j >= r.end) return;
-    map::update_point_covariance(v, vox, j, k, eps, line_ratio);
-  });
+    if (r.size() == 0) continue;  // the whole warp: one group
+    map::VoxelNeighborhood nb;
+    nb.centre = map::unpack_key(v.voxel_keys[vox]);
+    if (lane < map::kNeighborVoxels) {
+      found[warp][lane] = map::table_find(v, map::neighbor_voxel(nb.centre, static_cast<int>(lane)));
+    }
+    __syncwarp();
+    for (int n = 0; n < map::kNeighborVoxels; ++n) nb.voxels[n] = found[warp][n];
+    __syncwarp();  // read before the next group's lookups
+    for (std::int32_t j = r.begin + static_cast<std::int32_t>(lane); j < r.end; j += kWarpLanes) {
+      map::update_point_covariance(v, nb, vox, j, k, eps, line_ratio);
+    }
+  }
+}
+
+void update_group_covariances(const map::MapView& v, MapScratch& s, CudaExecutor& ex, std::size_t groups,
+                              const VoxelMapConfig& config, bool refresh) {
+  const std::size_t blocks = std::min((groups + kCovarianceWarps - 1) / kCovarianceWarps, kMaxCovarianceBlocks);
+  group_covariance_kernel<<<static_cast<unsigned>(blocks), kCovarianceWarps * kWarpLanes, 0, ex.stream()>>>(
+      v, s.group_voxel.data(), s.first_new.data(), groups, config.covariance_neighbors,
+      static_cast<float>(config.covariance_epsilon), static_cast<float>(config.line_eigenvalue_ratio), refresh);
+  FARLIO_CUDA_CHECK(cudaGetLastError());
 }
 
 }  // namespace
@@ -249,7 +275,8 @@ void DeviceVoxelMap::insert_async(const Eigen::Vector3f* points, std::size_t n, 
   const bool refresh = config_.refresh_covariances;
   const bool compute = covariances == map::CovarianceUpdate::Compute;
   const map::InsertParams ip{origin, limit, spacing_m_ * spacing_m_};
-  insert_groups(v, s, ex, points, groups, ip, compute, refresh, table_full, &device_counts_.data()->insert);
+  insert_groups(v, s, ex, points, sorted.valid, groups, ip, compute, refresh, table_full,
+                &device_counts_.data()->insert);
 
   // 4. covariances of the new points (or of every point of a changed voxel)
   if (compute) update_group_covariances(v, s, ex, groups, config_, refresh);
@@ -343,14 +370,16 @@ void DeviceVoxelMap::gather_async(Eigen::Vector4f* out_points, map::Cov3* out_co
   executor_->for_each(hw + 1, [=] __device__(std::size_t i) { counts[i] = i < hw ? v.voxel_counts[i] : 0; });
   algorithms_->exclusive_sum(counts, offsets, hw + 1);
   // the total is known on the device only: no point is written beyond the capacity
+  // one thread a point slot
   const auto limit = static_cast<std::int64_t>(capacity);
-  executor_->for_each(hw, [=] __device__(std::size_t i) {
-    if (i == 0) *gathered = offsets[hw];
-    const auto vox = static_cast<std::int32_t>(i);
-    for (std::int32_t j = 0; j < v.voxel_counts[i] && offsets[i] + j < limit; ++j) {
-      out_points[offsets[i] + j] = v.points[v.point_index(vox, j)];
-      out_covs[offsets[i] + j] = v.covs[v.point_index(vox, j)];
-    }
+  const auto slots = static_cast<std::size_t>(config_.max_points_per_voxel);
+  executor_->for_each(hw * slots, [=] __device__(std::size_t t) {
+    if (t == 0) *gathered = offsets[hw];
+    const auto vox = static_cast<std::int32_t>(t / slots);
+    const auto j = static_cast<std::int32_t>(t % slots);
+    if (j >= v.voxel_counts[vox] || offsets[vox] + j >= limit) return;
+    out_points[offsets[vox] + j] = v.points[v.point_index(vox, j)];
+    out_covs[offsets[vox] + j] = v.covs[v.point_index(vox, j)];
   });
 }
 

@@ -89,11 +89,14 @@ BandwidthSample measure_copy(CudaExecutor& ex, std::size_t bytes, int repeats) {
   return s;
 }
 
-BandwidthSample measure_upload(CudaExecutor& ex, std::size_t bytes, int repeats) {
+BandwidthSample measure_upload(CudaExecutor& ex, StagedUpload& staging, std::size_t bytes, int repeats) {
   const std::vector<unsigned char> host(bytes, 1);
   DeviceBuffer<unsigned char> device(bytes, "upload bytes");
   BandwidthSample s{"scan upload (host)", 0.0, static_cast<double>(bytes)};
-  s.ms = median_ms(ex, repeats, [&] { device.upload(host.data(), bytes, ex.stream(), "upload bytes"); });
+  s.ms = median_ms(ex, repeats, [&] {
+    staging.begin_frame();
+    staging.upload(host.data(), device.data(), bytes, ex.stream());
+  });
   return s;
 }
 

@@ -11,6 +11,7 @@
 
 #include "farlio/core/se3.hpp"
 #include "farlio/cuda/cuda_executor.hpp"
+#include "farlio/cuda/staged_upload.hpp"
 #include "farlio/map/map_view.hpp"
 
 namespace farlio::cuda {
@@ -25,9 +26,9 @@ struct BandwidthSample {
 /// The copy ceiling: `bytes` copied from one device buffer to another (allocates both).
 BandwidthSample measure_copy(CudaExecutor& executor, std::size_t bytes, int repeats);
 
-/// The upload of a scan: `bytes` copied from pageable host memory to the device, as the backend
-/// copies each scan (DeviceBuffer::upload from the caller's vectors).
-BandwidthSample measure_upload(CudaExecutor& executor, std::size_t bytes, int repeats);
+/// The upload of a scan: `bytes` copied from host memory (warm: the same bytes each time) to the
+/// device through `staging`, as the backend copies each scan.
+BandwidthSample measure_upload(CudaExecutor& executor, StagedUpload& staging, std::size_t bytes, int repeats);
 
 /// k-NN of n device points in `target` (k neighbours within sqrt(max_distance2)).
 BandwidthSample measure_knn(CudaExecutor& executor, const map::ConstMapView& target, const Eigen::Vector4f* points,

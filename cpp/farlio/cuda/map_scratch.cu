@@ -20,6 +20,7 @@ MapScratch::MapScratch(std::size_t n, CudaExecutor& executor)
       short_keys(n, "keys"),
       iota(n, "keys"),
       sorted_order(n, "keys"),
+      sorted_points(n, "keys"),
       flags(n, "keys"),
       group_start(n, "keys"),
       group_voxel(n, "keys"),
@@ -34,9 +35,9 @@ MapScratch::MapScratch(std::size_t n, CudaExecutor& executor)
 }
 
 std::size_t MapScratch::memory_bytes() const {
-  return keys.bytes() + sorted_keys.bytes() + short_keys.bytes() + iota.bytes() + sorted_order.bytes() + flags.bytes() +
-         group_start.bytes() + group_voxel.bytes() + missing.bytes() + rank.bytes() + first_new.bytes() +
-         group_stats.bytes() + scalars.bytes();
+  return keys.bytes() + sorted_keys.bytes() + short_keys.bytes() + iota.bytes() + sorted_order.bytes() +
+         sorted_points.bytes() + flags.bytes() + group_start.bytes() + group_voxel.bytes() + missing.bytes() +
+         rank.bytes() + first_new.bytes() + group_stats.bytes() + scalars.bytes();
 }
 
 namespace {

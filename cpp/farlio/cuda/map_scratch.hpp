@@ -2,6 +2,7 @@
 // The work arrays of one update (a map insertion, a removal, a downsampling), shared by the
 // maps of one backend since its stages run one after the other on one stream. Sized once for
 // the largest input: max(scan points, map voxels) + 1.
+#include <Eigen/Core>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -20,9 +21,10 @@ struct MapScratch {
 
   std::size_t items;
   DeviceBuffer<std::uint64_t> keys, sorted_keys;
-  DeviceBuffer<std::uint64_t> short_keys;   ///< keys shortened to a KeyWindow (sort_into_groups)
-  DeviceBuffer<std::int32_t> iota;          ///< 0, 1, 2, ... (filled once)
-  DeviceBuffer<std::int32_t> sorted_order;  ///< input index of each sorted key
+  DeviceBuffer<std::uint64_t> short_keys;       ///< keys shortened to a KeyWindow (sort_into_groups)
+  DeviceBuffer<std::int32_t> iota;              ///< 0, 1, 2, ... (filled once)
+  DeviceBuffer<std::int32_t> sorted_order;      ///< input index of each sorted key
+  DeviceBuffer<Eigen::Vector3f> sorted_points;  ///< an insertion's candidates in sorted order
   DeviceBuffer<std::uint8_t> flags;
   DeviceBuffer<std::int32_t> group_start;  ///< sorted position of each group's first key, then the end
   DeviceBuffer<std::int32_t> group_voxel, missing, rank, first_new;

@@ -34,7 +34,8 @@ class ReadBack {
   ReadSlot<T> post(const T* device, std::size_t n = 1) {
     static_assert(std::is_trivially_copyable_v<T>, "read-back values are copied bytes");
     const std::size_t offset = reserve(n * sizeof(T), alignof(T));
-    if (n > 0) FARLIO_CUDA_CHECK(cudaMemcpyAsync(host_ + offset, device, n * sizeof(T), cudaMemcpyDeviceToHost, stream_));
+    if (n > 0)
+      FARLIO_CUDA_CHECK(cudaMemcpyAsync(host_ + offset, device, n * sizeof(T), cudaMemcpyDeviceToHost, stream_));
     return {offset};
   }
   /// Waits for every copy queued on the stream (one synchronisation).

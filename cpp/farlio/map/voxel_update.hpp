@@ -120,26 +120,24 @@ FARLIO_HD void point_covariance(const MapView& m, std::int32_t voxel, std::int32
   m.points[pi].w() = shape_code(classify_shape(cov, line_ratio));
 }
 
-/// The covariance of point j of `voxel` (one GPU thread a point): reads the points of the 27
-/// voxels around it.
-FARLIO_HD inline void update_point_covariance(const MapView& m, std::int32_t voxel, std::int32_t j, int k,
-                                              float epsilon, float line_ratio) {
+/// The covariance of point j of `voxel` from the 27 voxels around it, looked up before (`nb`):
+/// the CPU loops over a voxel's points (update_voxel_covariances), CUDA runs one point a lane
+/// of the warp that looked the voxels up.
+FARLIO_HD inline void update_point_covariance(const MapView& m, const VoxelNeighborhood& nb, std::int32_t voxel,
+                                              std::int32_t j, int k, float epsilon, float line_ratio) {
   point_covariance(m, voxel, j, k, epsilon, line_ratio, [&](const Eigen::Vector3f& p, std::int64_t* idx, float* d2) {
-    return knn_search(m, p, k, kUnboundedDistance2, idx, d2);
+    return knn_search(m, nb, p, k, kUnboundedDistance2, idx, d2);
   });
 }
 
 /// Covariances of the points `points` of `voxel` (one CPU task a voxel): the 27 voxels around
-/// it are looked up once for all of them (the same result as update_point_covariance).
+/// it are looked up once for all of them.
 FARLIO_HD inline void update_voxel_covariances(const MapView& m, std::int32_t voxel, const PointRange& points, int k,
                                                float epsilon, float line_ratio) {
   if (points.size() == 0) return;
   const VoxelNeighborhood nb = voxel_neighborhood(m, unpack_key(m.voxel_keys[voxel]));
-  for (std::int32_t j = points.begin; j < points.end; ++j) {
-    point_covariance(m, voxel, j, k, epsilon, line_ratio, [&](const Eigen::Vector3f& p, std::int64_t* idx, float* d2) {
-      return knn_search(m, nb, p, k, kUnboundedDistance2, idx, d2);
-    });
-  }
+  for (std::int32_t j = points.begin; j < points.end; ++j)
+    update_point_covariance(m, nb, voxel, j, k, epsilon, line_ratio);
 }
 
 /// Squared distance (double) from `origin` to the centre of the voxel with this key.

@@ -40,6 +40,12 @@ class ScanBackend {
   /// Range crop, undistortion into the scan-end frame (when `undistort`), downsampling to the
   /// map spacing. Keeps the frame; returns its size.
   virtual std::size_t preprocess(const Scan& scan, const deskew::ScanMotion& motion, bool undistort) = 0;
+  /// Whether preprocess drops the points with NaN or Inf coordinates or times itself, and counts
+  /// them (non_finite_points()). Otherwise the pipeline removes them before, in a pass over the
+  /// scan on the host: ~0.1-0.3 ms for a cold 120-210k-point scan, a quarter of a GPU frame.
+  [[nodiscard]] virtual bool screens_non_finite_points() const { return false; }
+  /// The points that the last preprocess dropped as non-finite (0 where it does not screen).
+  [[nodiscard]] virtual std::size_t non_finite_points() const { return 0; }
   /// The per-scan frame map of the frame (sensor frame), the source cloud with its covariances,
   /// and the mean points per frame-map voxel within `density_range_m` of the sensor. Without
   /// `covariances` (nothing to register against: an empty submap) the source has the same

@@ -8,6 +8,7 @@
 
 #include "farlio/deskew/scan_motion.hpp"
 #include "farlio/exec/hd.hpp"
+#include "farlio/exec/hd_math.hpp"
 #include "farlio/map/voxel_update.hpp"
 #include "farlio/preprocess/range_crop.hpp"
 
@@ -19,6 +20,14 @@ struct PreprocessParams {
   bool undistort = false;
   float inv_cell_m = 1.0f;  ///< 1 / downsampling cell (the map spacing)
 };
+
+/// Whether the raw point has finite coordinates and, where the scan has times (`time` not null), a
+/// finite time: the points that Scan::remove_non_finite keeps. A backend that screens the scan
+/// itself (the CUDA backend, on the device) drops the others with this test.
+FARLIO_HD inline bool finite_point(const Eigen::Vector3f& raw, const float* time) {
+  return exec::is_finite(raw.x()) && exec::is_finite(raw.y()) && exec::is_finite(raw.z()) &&
+         (time == nullptr || exec::is_finite(*time));
+}
 
 /// The key of the raw point's downsampling cell, or kEmptyKey for a cropped, non-finite or
 /// out-of-range point. The cells are those of the raw positions: only the point kept in each cell
