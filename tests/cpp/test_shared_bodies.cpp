@@ -8,6 +8,7 @@
 #include <random>
 #include <vector>
 
+#include "farlio/core/types.hpp"
 #include "farlio/exec/cpu_executor.hpp"
 #include "farlio/exec/hd_math.hpp"
 #include "farlio/map/neighbor_search.hpp"
@@ -27,6 +28,41 @@ TEST(SharedBodies, PointKeyDropsNonFiniteAndOutOfRangePoints) {
   EXPECT_EQ(map::point_key({nan, 0, 0}, 1.0f), map::kEmptyKey);
   EXPECT_EQ(map::point_key({1e12f, 0, 0}, 1.0f), map::kEmptyKey);
   EXPECT_EQ(map::point_key({1.5f, -0.5f, 2.0f}, 1.0f), map::pack_key(map::VoxelCoord(1, -1, 2)));
+}
+
+TEST(SharedBodies, FinitePointKeepsThePointsThatTheScanKeeps) {
+  // the CUDA backend screens a scan on the device with finite_point; the pipeline screens it on
+  // the host with Scan::remove_non_finite for the CPU backend: the same points must stay
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  constexpr std::size_t kPoints = 4000;
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> pick(0, 9);
+  std::uniform_real_distribution<float> coord(-50.0f, 50.0f);
+  const float specials[] = {nan, inf, -inf, std::numeric_limits<float>::max()};
+  Scan scan;
+  for (std::size_t i = 0; i < kPoints; ++i) {
+    Eigen::Vector3f p(coord(rng), coord(rng), coord(rng));
+    float t = 0.05f;
+    const int r = pick(rng);
+    if (r < 3) p[r] = specials[static_cast<std::size_t>(pick(rng)) % 4];  // a coordinate
+    if (r == 3) t = specials[static_cast<std::size_t>(pick(rng)) % 3];    // the time
+    scan.points.push_back(p);
+    scan.time_s.push_back(t);
+  }
+  std::vector<Eigen::Vector3f> screened;
+  for (std::size_t i = 0; i < kPoints; ++i) {
+    if (preprocess::finite_point(scan.points[i], &scan.time_s[i])) screened.push_back(scan.points[i]);
+  }
+  std::size_t without_times = 0;  // a scan without times: the coordinates alone
+  for (const auto& p : scan.points) without_times += preprocess::finite_point(p, nullptr) ? 1 : 0;
+  Scan host = scan;
+  const std::size_t removed = host.remove_non_finite();
+  EXPECT_GT(removed, kPoints / 5);
+  EXPECT_EQ(kPoints - removed, screened.size());
+  EXPECT_EQ(host.points, screened);
+  host = scan;
+  host.time_s.clear();
+  EXPECT_EQ(kPoints - host.remove_non_finite(), without_times);
 }
 
 TEST(SharedBodies, FloorToIntEqualsFloorfOverTheIntRange) {

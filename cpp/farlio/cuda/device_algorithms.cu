@@ -48,20 +48,22 @@ std::size_t temp_bytes_for(std::size_t max_items) {
 DeviceAlgorithms::DeviceAlgorithms(std::size_t max_items, cudaStream_t stream)
     : max_items_(max_items), stream_(stream), temp_(temp_bytes_for(max_items), "temporary bytes of CUB") {}
 
-void DeviceAlgorithms::require(std::size_t n, std::size_t temp_bytes) const {
+// Every call passes the whole temporary buffer, sized at construction for the largest input of
+// each algorithm (CUB takes more than it needs): asking CUB for the size first costs a second pass
+// through its dispatch on the host, for each of a frame's dozen calls.
+void DeviceAlgorithms::require(std::size_t n) const {
   if (n > max_items_) {
     throw CapacityError("CUDA backend: " + std::to_string(n) + " items exceed the " + std::to_string(max_items_) +
                         " the device buffers were sized for; raise cuda.max_scan_points");
   }
-  temp_.require(temp_bytes, "cuda.max_scan_points");
 }
 
 void DeviceAlgorithms::sort_pairs(const std::uint64_t* keys_in, std::uint64_t* keys_out, const std::int32_t* values_in,
                                   std::int32_t* values_out, std::size_t n, int key_bits) {
   if (n == 0) return;
   if (key_bits <= 0 || key_bits > kKeyBits) throw std::invalid_argument("sort_pairs: key_bits must be in [1, 64]");
-  std::size_t bytes = sort_bytes(n, key_bits);
-  require(n, bytes);
+  require(n);
+  std::size_t bytes = temp_.bytes();
   FARLIO_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp_.data(), bytes, keys_in, keys_out, values_in, values_out,
                                                     static_cast<int>(n), 0, key_bits, stream_));
 }
@@ -72,16 +74,16 @@ void DeviceAlgorithms::select_flagged(const std::int32_t* in, const std::uint8_t
     FARLIO_CUDA_CHECK(cudaMemsetAsync(count, 0, sizeof(std::int32_t), stream_));
     return;
   }
-  std::size_t bytes = select_bytes(n);
-  require(n, bytes);
+  require(n);
+  std::size_t bytes = temp_.bytes();
   FARLIO_CUDA_CHECK(
       cub::DeviceSelect::Flagged(temp_.data(), bytes, in, flags, out, count, static_cast<int>(n), stream_));
 }
 
 void DeviceAlgorithms::exclusive_sum(const std::int32_t* in, std::int32_t* out, std::size_t n) {
   if (n == 0) return;
-  std::size_t bytes = scan_bytes(n);
-  require(n, bytes);
+  require(n);
+  std::size_t bytes = temp_.bytes();
   FARLIO_CUDA_CHECK(cub::DeviceScan::ExclusiveSum(temp_.data(), bytes, in, out, static_cast<int>(n), stream_));
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 // The CUB device-wide algorithms the backend needs (radix sort of key/index pairs, stream
-// compaction, exclusive prefix sum) over one temporary buffer sized once for the largest input.
+// compaction, exclusive prefix sum) over one temporary buffer sized once for the largest input
+// of each.
 // Plain C++ header; the calls are in device_algorithms.cu.
 #include <cuda_runtime_api.h>
 
@@ -30,7 +31,7 @@ class DeviceAlgorithms {
   [[nodiscard]] std::size_t memory_bytes() const { return temp_.bytes(); }
 
  private:
-  void require(std::size_t n, std::size_t temp_bytes) const;
+  void require(std::size_t n) const;
 
   std::size_t max_items_;
   cudaStream_t stream_;

@@ -17,7 +17,8 @@ constexpr std::size_t kCopyBlockBytes = std::size_t{64} << 10;
 }  // namespace
 
 StagedUpload::StagedUpload(std::size_t capacity_bytes, int threads)
-    : capacity_(capacity_bytes), copier_(std::make_unique<exec::CpuExecutor>(threads)) {
+    : capacity_(capacity_bytes),
+      copier_(std::make_unique<exec::CpuExecutor>(threads > 0 ? std::min(threads, kMaxCopyThreads) : kMaxCopyThreads)) {
   FARLIO_CUDA_CHECK(cudaMallocHost(reinterpret_cast<void**>(&pinned_), std::max<std::size_t>(capacity_, 1)));
   FARLIO_CUDA_CHECK(cudaEventCreateWithFlags(&taken_, cudaEventDisableTiming));
   copier_->warm_up();

@@ -17,8 +17,12 @@ namespace farlio::cuda {
 
 class StagedUpload {
  public:
+  /// Host threads of a copy at most: four reach a host's memory bandwidth for a 2-4 MB copy, and
+  /// each thread more is one more that a busy host can preempt in the middle of a frame.
+  static constexpr int kMaxCopyThreads = 4;
+
   /// `capacity_bytes`: what one frame uploads at most; `threads`: host threads of the copies
-  /// into page-locked memory (0: all).
+  /// into page-locked memory (0: kMaxCopyThreads; never more).
   StagedUpload(std::size_t capacity_bytes, int threads);
   ~StagedUpload();
   StagedUpload(const StagedUpload&) = delete;
