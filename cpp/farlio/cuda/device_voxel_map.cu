@@ -60,7 +60,60 @@ void add_group_voxels(const map::MapView& v, MapScratch& s, CudaExecutor& ex, st
   });
 }
 
-/// Inserts each voxel's candidates in order, with the cap and the spacing (one thread a voxel;
+constexpr unsigned kWarpLanes = 32;
+constexpr unsigned kFullWarp = 0xffffffffu;
+constexpr unsigned kGroupWarps = 4;  // a block's warps: a voxel group each
+constexpr std::size_t kMaxGroupBlocks = 65535;
+
+/// Blocks of kGroupWarps warps for one warp a group (grid-stride beyond kMaxGroupBlocks).
+unsigned group_blocks(std::size_t groups) {
+  return static_cast<unsigned>(std::min((groups + kGroupWarps - 1) / kGroupWarps, kMaxGroupBlocks));
+}
+
+/// Inserts each group's candidates in order, one warp a group: the candidates one after the
+/// other (a candidate's spacing test depends on the points stored before it), each tested
+/// against the voxel's stored points by all lanes at once. The decisions of
+/// map::insert_voxel_group (the CPU's loop, one stored point after the other), with its bodies.
+__global__ void __launch_bounds__(kGroupWarps* kWarpLanes)
+    group_insert_kernel(map::MapView v, const Eigen::Vector3f* sorted, const std::int32_t* group_start,
+                        const std::int32_t* group_voxel, std::size_t groups, map::InsertParams ip,
+                        std::int32_t* first_new, map::GroupStats* gstats) {
+  const auto lane = static_cast<std::int32_t>(threadIdx.x % kWarpLanes);
+  const unsigned warp = threadIdx.x / kWarpLanes;
+  const std::size_t stride = static_cast<std::size_t>(gridDim.x) * kGroupWarps;
+  for (std::size_t g = static_cast<std::size_t>(blockIdx.x) * kGroupWarps + warp; g < groups; g += stride) {
+    const std::int32_t vox = group_voxel[g];
+    const std::int32_t before = v.voxel_counts[vox];
+    std::int32_t count = before;
+    map::GroupStats s;
+    for (std::int32_t c = group_start[g]; c < group_start[g + 1]; ++c) {  // the same c in every lane
+      const Eigen::Vector3f p = sorted[c];
+      if (count >= map::candidate_cap(v, ip, p)) {
+        ++s.full;
+        continue;
+      }
+      bool close = false;
+      for (std::int32_t j = lane; j < count && !close; j += static_cast<std::int32_t>(kWarpLanes)) {
+        close = map::too_close(v, vox, j, p, ip);
+      }
+      if (__any_sync(kFullWarp, close)) {
+        ++s.spacing;
+        continue;
+      }
+      if (lane == 0) map::store_point(v, vox, count, p);
+      __syncwarp();  // the stored point is visible to every lane before the next candidate's test
+      ++count;
+      ++s.inserted;
+    }
+    if (lane == 0) {
+      v.voxel_counts[vox] = count;
+      first_new[g] = before;
+      gstats[g] = s;
+    }
+  }
+}
+
+/// Inserts each voxel's candidates in order, with the cap and the spacing (one warp a voxel;
 /// `candidates`: the sorted ones that have a voxel, the groups' points),
 /// and sums the groups' counts (the covariances to compute when `compute`) with the table's
 /// failed insertions into *totals (on the device).
@@ -72,15 +125,13 @@ void insert_groups(const map::MapView& v, MapScratch& s, CudaExecutor& ex, const
   const std::int32_t* group_voxel = s.group_voxel.data();
   std::int32_t* first_new = s.first_new.data();
   map::GroupStats* gstats = s.group_stats.data();
-  // the candidates in sorted order first, one thread each: a group's thread then reads its
+  // the candidates in sorted order first, one thread each: a group's warp then reads its
   // candidates one after the other from contiguous memory, not from all over the input
   Eigen::Vector3f* sorted = s.sorted_points.data();
   ex.for_each(candidates, [=] __device__(std::size_t c) { sorted[c] = points[order[c]]; });
-  ex.for_each(groups, [=] __device__(std::size_t g) {
-    const auto candidate = [=](std::int64_t c) { return sorted[c]; };
-    gstats[g] =
-        map::insert_voxel_group(v, group_voxel[g], candidate, group_start[g], group_start[g + 1], ip, &first_new[g]);
-  });
+  group_insert_kernel<<<group_blocks(groups), kGroupWarps * kWarpLanes, 0, ex.stream()>>>(
+      v, sorted, group_start, group_voxel, groups, ip, first_new, gstats);
+  FARLIO_CUDA_CHECK(cudaGetLastError());
   ex.reduce_into(
       groups, InsertTotals{},
       [=] __device__(std::size_t g) {
@@ -96,21 +147,17 @@ void insert_groups(const map::MapView& v, MapScratch& s, CudaExecutor& ex, const
       Add{}, totals);
 }
 
-constexpr unsigned kWarpLanes = 32;
-constexpr unsigned kCovarianceWarps = 4;  // a block's warps: a group each
-constexpr std::size_t kMaxCovarianceBlocks = 65535;
-
 /// Covariances of the new points (or of every point of a changed voxel): one warp a group. Its
 /// lanes look up the 27 voxels around the group's voxel together, then each lane computes a
 /// point's covariance from them (map::update_point_covariance; the CPU runs the same body in a
 /// loop over the voxel's points, one task a voxel).
-__global__ void __launch_bounds__(kCovarianceWarps* kWarpLanes)
+__global__ void __launch_bounds__(kGroupWarps* kWarpLanes)
     group_covariance_kernel(map::MapView v, const std::int32_t* group_voxel, const std::int32_t* first_new,
                             std::size_t groups, int k, float eps, float line_ratio, bool refresh) {
-  __shared__ std::int32_t found[kCovarianceWarps][map::kNeighborVoxels];
+  __shared__ std::int32_t found[kGroupWarps][map::kNeighborVoxels];
   const unsigned lane = threadIdx.x % kWarpLanes, warp = threadIdx.x / kWarpLanes;
-  const std::size_t stride = static_cast<std::size_t>(gridDim.x) * kCovarianceWarps;
-  for (std::size_t g = static_cast<std::size_t>(blockIdx.x) * kCovarianceWarps + warp; g < groups; g += stride) {
+  const std::size_t stride = static_cast<std::size_t>(gridDim.x) * kGroupWarps;
+  for (std::size_t g = static_cast<std::size_t>(blockIdx.x) * kGroupWarps + warp; g < groups; g += stride) {
     const std::int32_t vox = group_voxel[g];
     const map::PointRange r = map::covariance_points(v.voxel_counts[vox], first_new[g], refresh);
     if (r.size() == 0) continue;  // the whole warp: one group
@@ -130,8 +177,7 @@ __global__ void __launch_bounds__(kCovarianceWarps* kWarpLanes)
 
 void update_group_covariances(const map::MapView& v, MapScratch& s, CudaExecutor& ex, std::size_t groups,
                               const VoxelMapConfig& config, bool refresh) {
-  const std::size_t blocks = std::min((groups + kCovarianceWarps - 1) / kCovarianceWarps, kMaxCovarianceBlocks);
-  group_covariance_kernel<<<static_cast<unsigned>(blocks), kCovarianceWarps * kWarpLanes, 0, ex.stream()>>>(
+  group_covariance_kernel<<<group_blocks(groups), kGroupWarps * kWarpLanes, 0, ex.stream()>>>(
       v, s.group_voxel.data(), s.first_new.data(), groups, config.covariance_neighbors,
       static_cast<float>(config.covariance_epsilon), static_cast<float>(config.line_eigenvalue_ratio), refresh);
   FARLIO_CUDA_CHECK(cudaGetLastError());

@@ -51,9 +51,28 @@ struct InsertParams {
   float spacing2;  ///< squared minimum distance between points of a voxel
 };
 
+/// The most points a voxel may hold when the candidate p arrives: the limit at p's distance from
+/// the sensor, at most the pool's slots.
+FARLIO_HD inline int candidate_cap(const MapView& m, const InsertParams& ip, const Eigen::Vector3f& p) {
+  const int lim = ip.limit.at((p - ip.origin).norm());
+  return lim < m.max_points_per_voxel ? lim : m.max_points_per_voxel;
+}
+
+/// Whether the stored point j of `voxel` is closer to p than the spacing.
+FARLIO_HD inline bool too_close(const MapView& m, std::int32_t voxel, std::int32_t j, const Eigen::Vector3f& p,
+                                const InsertParams& ip) {
+  return (m.points[m.point_index(voxel, j)].head<3>() - p).squaredNorm() < ip.spacing2;
+}
+
+/// Stores p in slot j of `voxel` (no shape yet: its covariance comes after the insertion).
+FARLIO_HD inline void store_point(const MapView& m, std::int32_t voxel, std::int32_t j, const Eigen::Vector3f& p) {
+  m.points[m.point_index(voxel, j)] = Eigen::Vector4f(p.x(), p.y(), p.z(), 0.0f);
+}
+
 /// Inserts the candidates candidate(c), c in [begin, end), into `voxel` in that order: a
 /// candidate is stored unless the voxel holds its limit or a stored point is closer than the
-/// spacing. `*first_new` receives the voxel's count before the insertion.
+/// spacing. `*first_new` receives the voxel's count before the insertion. (CUDA makes the same
+/// decisions with a warp a voxel, the lanes testing the stored points together.)
 template <typename Candidate>
 FARLIO_HD GroupStats insert_voxel_group(const MapView& m, std::int32_t voxel, const Candidate& candidate,
                                         std::int64_t begin, std::int64_t end, const InsertParams& ip,
@@ -63,20 +82,17 @@ FARLIO_HD GroupStats insert_voxel_group(const MapView& m, std::int32_t voxel, co
   *first_new = count;
   for (std::int64_t c = begin; c < end; ++c) {
     const Eigen::Vector3f p = candidate(c);
-    const int lim = ip.limit.at((p - ip.origin).norm());
-    if (count >= (lim < m.max_points_per_voxel ? lim : m.max_points_per_voxel)) {
+    if (count >= candidate_cap(m, ip, p)) {
       ++s.full;
       continue;
     }
-    bool too_close = false;
-    for (std::int32_t j = 0; j < count && !too_close; ++j) {
-      too_close = (m.points[m.point_index(voxel, j)].head<3>() - p).squaredNorm() < ip.spacing2;
-    }
-    if (too_close) {
+    bool close = false;
+    for (std::int32_t j = 0; j < count && !close; ++j) close = too_close(m, voxel, j, p, ip);
+    if (close) {
       ++s.spacing;
       continue;
     }
-    m.points[m.point_index(voxel, count)] = Eigen::Vector4f(p.x(), p.y(), p.z(), 0.0f);
+    store_point(m, voxel, count, p);
     ++count;
     ++s.inserted;
   }
