@@ -53,17 +53,30 @@ void expect_same_maps(const map::MapSnapshot& cpu, const map::MapSnapshot& gpu, 
   EXPECT_LE(static_cast<double>(flips), kMaxShapeFlipFraction * static_cast<double>(compared));
 }
 
+/// A limit that decays with the distance (the adaptive density's shape).
+const map::PointLimit kDecayingLimit{30, 10.0f, 0.5f, 10};
+
+/// A host map and a device map with 2 m voxels that removal empties beyond 30 m.
+struct RemovalMaps {
+  static VoxelMapConfig config() {
+    VoxelMapConfig cfg;
+    cfg.voxel_size_m = 2.0;
+    cfg.removal_radius_m = 30.0;
+    return cfg;
+  }
+  exec::CpuExecutor executor{2};
+  map::VoxelMap cpu{config(), executor};
+  test::DeviceMapRig gpu{config(), kVoxelCapacity};
+};
+
 }  // namespace
 
 TEST(CudaMap, InsertionRemovalAndCovariancesEqualTheCpu) {
   FARLIO_REQUIRE_GPU();
-  VoxelMapConfig cfg;
-  cfg.voxel_size_m = 2.0;
-  cfg.removal_radius_m = 30.0;
-  exec::CpuExecutor ex(2);
-  map::VoxelMap cpu(cfg, ex);
-  test::DeviceMapRig gpu(cfg, kVoxelCapacity);
-  const map::PointLimit asmd{30, 10.0f, 0.5f, 10};
+  RemovalMaps maps;
+  map::VoxelMap& cpu = maps.cpu;
+  test::DeviceMapRig& gpu = maps.gpu;
+  const map::PointLimit& asmd = kDecayingLimit;
   const auto a = test::sample_scene(kScenePoints, 11, 0.02f);
   const auto b = shifted(test::sample_scene(kScenePoints, 12, 0.02f), {20.0f, 3.0f, 0.0f});
   const auto sa = cpu.insert(a, Eigen::Vector3f::Zero(), asmd);
@@ -168,13 +181,10 @@ TEST(CudaMap, QueuedUpdatesReadBackInOneWaitAsTheCpuCountsThem) {
   // insertion, removal, the points stored and the density queued, their counts read back together
   // (as the backend's map update does); the free list they leave serves the next insertion
   FARLIO_REQUIRE_GPU();
-  VoxelMapConfig cfg;
-  cfg.voxel_size_m = 2.0;
-  cfg.removal_radius_m = 30.0;
-  exec::CpuExecutor ex(2);
-  map::VoxelMap cpu(cfg, ex);
-  test::DeviceMapRig gpu(cfg, kVoxelCapacity);
-  const map::PointLimit asmd{30, 10.0f, 0.5f, 10};
+  RemovalMaps maps;
+  map::VoxelMap& cpu = maps.cpu;
+  test::DeviceMapRig& gpu = maps.gpu;
+  const map::PointLimit& asmd = kDecayingLimit;
   const auto a = test::sample_scene(kScenePoints, 51, 0.02f);
   const auto b = shifted(test::sample_scene(kScenePoints, 52, 0.02f), {20.0f, 3.0f, 0.0f});
   const auto c = shifted(test::sample_scene(kScenePoints, 53, 0.02f), {45.0f, -2.0f, 0.0f});

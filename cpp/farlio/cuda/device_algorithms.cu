@@ -12,12 +12,12 @@ namespace {
 
 constexpr int kKeyBits = 8 * sizeof(std::uint64_t);
 
-std::size_t sort_bytes(std::size_t n, int key_bits = kKeyBits) {
+std::size_t sort_bytes(std::size_t n) {
   std::size_t bytes = 0;
   FARLIO_CUDA_CHECK(
       cub::DeviceRadixSort::SortPairs(nullptr, bytes, static_cast<const std::uint64_t*>(nullptr),
                                       static_cast<std::uint64_t*>(nullptr), static_cast<const std::int32_t*>(nullptr),
-                                      static_cast<std::int32_t*>(nullptr), static_cast<int>(n), 0, key_bits));
+                                      static_cast<std::int32_t*>(nullptr), static_cast<int>(n), 0, kKeyBits));
   return bytes;
 }
 
