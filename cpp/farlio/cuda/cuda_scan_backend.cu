@@ -156,7 +156,7 @@ class CudaScanBackend final : public pipeline::ScanBackend {
                             covariances ? map::CovarianceUpdate::Compute : map::CovarianceUpdate::Skip);
     frame_map_.gather_async(source_points_.data(), source_covs_.data(), source_points_.capacity(), kScanParameter);
     frame_map_.mean_points_per_voxel_async(Eigen::Vector3f::Zero(), density_range_m);
-    const MapResults r = read_back(frame_map_);
+    const MapResults r = frame_map_.read_results();
     source_size_ = r.gathered_points;
     timer_.stop(StageTimer::kSource);
     return {source_size_, r.mean_points_per_voxel};
@@ -202,21 +202,12 @@ class CudaScanBackend final : public pipeline::ScanBackend {
     map_.insert_async(world_.data(), frame_size_, t, limit, points_within_m());
     map_.remove_far_async(t);
     map_.num_points_async();
-    const MapResults r = read_back(map_);
+    const MapResults r = map_.read_results();
     *removed_voxels = r.removed_voxels;
     map_points_ = r.points;
     last_pose_ = pose;
     timer_.stop(StageTimer::kMapUpdate);
     return r.insert;
-  }
-
-  /// The counts that `map`'s queued work left on the device, with one wait.
-  MapResults read_back(DeviceVoxelMap& map) {
-    ReadBack& rb = executor_.read_back();
-    rb.clear();
-    map.post(rb);
-    rb.wait();
-    return map.settle(rb);
   }
 
   /// In pieces of the scan buffers' size, in input order (as the CPU backend's one insert).

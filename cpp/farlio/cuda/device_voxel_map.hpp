@@ -119,6 +119,8 @@ class DeviceVoxelMap {
   /// after a removal that leaves too many erased slots); throws CapacityError when the table or
   /// a gather's destination was too small.
   MapResults settle(const ReadBack& read_back);
+  /// post(), the executor's read-back's wait, settle(): the queued work's results with one wait.
+  MapResults read_results();
   /// Rebuilds the table from the live voxels (drops erased markers).
   void rehash();
 
@@ -139,8 +141,6 @@ class DeviceVoxelMap {
   template <typename View, typename Self>
   static View view_of(Self& self);
   [[nodiscard]] map::PoolCounts counts() const;
-  /// post(), wait, settle(): the plain calls' read-back.
-  MapResults read_results();
 
   /// What the *_async calls since the last settle() left to read.
   struct Pending {
