@@ -1,6 +1,8 @@
 // The scan pipeline (LiDAR-only) on scans of a synthetic scene seen from a known trajectory.
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include "farlio/pipeline/cpu_scan_backend.hpp"
 #include "farlio/pipeline/scan_pipeline.hpp"
 #include "scene_fixture.hpp"
@@ -82,6 +84,29 @@ TEST(ScanPipeline, EmptyAndDegenerateScansDoNotCrash) {
   const auto r1 = p.process(nan);
   EXPECT_EQ(r1.kept_points, 0u);
   EXPECT_TRUE(r1.pose.translation().allFinite());
+}
+
+TEST(ScanPipeline, TheBackendDropsNonFinitePointsAsTheScanDoes) {
+  // the backend screens the scan in its first pass (the pipeline leaves it to it after the first
+  // scan): the same frame and the same count as Scan::remove_non_finite before a clean pass
+  Config cfg;
+  cfg.num_threads = 2;
+  pipeline::CpuScanBackend screening(cfg), clean(cfg);
+  Scan bad = make_scan(3, 0.1);
+  bad.start_stamp_ns = bad.end_stamp_ns - seconds_to_ns(0.1);
+  for (std::size_t i = 0; i < bad.size(); ++i) bad.time_s.push_back(static_cast<float>(0.1 * i / bad.size()));
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  for (std::size_t i = 0; i < bad.size(); i += 53) bad.points[i].y() = nan;
+  for (std::size_t i = 7; i < bad.size(); i += 71) bad.points[i].z() = -inf;
+  for (std::size_t i = 11; i < bad.size(); i += 61) bad.time_s[i] = nan;
+  Scan dropped = bad;
+  const std::size_t removed = dropped.remove_non_finite();
+  ASSERT_GT(removed, bad.size() / 40);
+  const deskew::ScanMotion motion = deskew::ScanMotion::constant_twist(deskew::Vec6f::Constant(0.3f), 0.1f);
+  EXPECT_EQ(screening.preprocess(bad, motion, true), clean.preprocess(dropped, motion, true));
+  EXPECT_EQ(screening.non_finite_points(), removed);
+  EXPECT_EQ(clean.non_finite_points(), 0u);
+  EXPECT_EQ(screening.frame_points(), clean.frame_points());
 }
 
 TEST(ScanPipeline, PointsWithNonFiniteTimesAreDroppedAsTheReadersDo) {

@@ -93,7 +93,6 @@ class CudaScanBackend final : public pipeline::ScanBackend {
     return frame_size_;
   }
 
-  [[nodiscard]] bool screens_non_finite_points() const override { return true; }
   [[nodiscard]] std::size_t non_finite_points() const override { return non_finite_points_; }
 
   /// Non-finite points dropped and counted, the crop and the keys of the downsampling cells (one

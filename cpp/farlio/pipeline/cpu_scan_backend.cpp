@@ -1,5 +1,7 @@
 #include "farlio/pipeline/cpu_scan_backend.hpp"
 
+#include <atomic>
+
 #include "farlio/preprocess/downsampling_keys.hpp"
 #include "farlio/preprocess/preprocess_point.hpp"
 
@@ -25,11 +27,18 @@ std::size_t CpuScanBackend::preprocess(const Scan& scan, const deskew::ScanMotio
   const preprocess::PreprocessParams pp{preprocess::RangeCrop::from(config_.preprocess),
                                         deskew::DeskewTable::sample(motion, static_cast<float>(scan.duration_s())),
                                         undistort, 1.0f / map_.spacing_m()};
-  // one pass: each thread crops its block of the scan and deduplicates its cells
+  // one pass: each thread drops the non-finite points of its block of the scan, crops the rest
+  // and deduplicates its cells
+  const float* times = scan.has_time() ? scan.time_s.data() : nullptr;
+  std::atomic<std::size_t> non_finite{0};
   const std::vector<std::int32_t>& kept = downsampler_.first_of_each_cell(
       scan.size(), executor_, [&](std::size_t first, std::size_t count, std::uint64_t* keys) {
         preprocess::downsampling_keys(scan.points.data() + first, count, pp, keys);
+        const std::size_t dropped =
+            preprocess::drop_non_finite(scan.points.data() + first, times ? times + first : nullptr, count, keys);
+        if (dropped > 0) non_finite.fetch_add(dropped, std::memory_order_relaxed);
       });
+  non_finite_points_ = non_finite.load();
   // then only the kept points are undistorted
   frame_.resize(kept.size());
   executor_.for_each(kept.size(), [&](std::size_t k) {

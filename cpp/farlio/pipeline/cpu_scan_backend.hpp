@@ -18,6 +18,7 @@ class CpuScanBackend final : public ScanBackend {
   [[nodiscard]] Device device() const override { return Device::Cpu; }
   void reset(const Config& config) override;
   std::size_t preprocess(const Scan& scan, const deskew::ScanMotion& motion, bool undistort) override;
+  [[nodiscard]] std::size_t non_finite_points() const override { return non_finite_points_; }
   SourceSummary build_source(double density_range_m, bool covariances) override;
   registration::RegistrationResult register_source(const SE3& initial_guess, const registration::Thresholds& th,
                                                    const RegistrationConfig& config, double time_budget_s) override;
@@ -36,6 +37,7 @@ class CpuScanBackend final : public ScanBackend {
   map::VoxelMap frame_map_;
   preprocess::CellDownsampler downsampler_;
   std::vector<Eigen::Vector3f> frame_;  // the kept points (sensor frame, scan end)
+  std::size_t non_finite_points_ = 0;   // of the last scan
   registration::SourceCloud source_;
 };
 

@@ -124,11 +124,10 @@ FrameResult ScanPipeline::process(const Scan& input, const std::optional<SE3>& i
   out.stamp_ns = input.end_stamp_ns;
   out.input_points = input.size();
   // points with NaN or Inf coordinates or times are dropped, as the readers drop them (a NaN time
-  // has no place in the undistortion): by the backend where it screens them (on the device), else
-  // here; here always for the scan that fixes the map's scale
+  // has no place in the undistortion): by the backend, in its first pass over the scan, and here
+  // before the scan that fixes the map's scale
   std::optional<Scan> finite;
-  const bool backend_screens = scale_fixed_ && backend_->screens_non_finite_points();
-  if (!backend_screens && !input.all_finite()) {
+  if (!scale_fixed_ && !input.all_finite()) {
     finite = input;
     out.non_finite_points = finite->remove_non_finite();
   }
@@ -174,7 +173,7 @@ void ScanPipeline::preprocess(const Scan& scan, const deskew::ScanMotion& scan_m
   out.motion = scan_motion;
   out.undistorted = undistort;
   out.kept_points = backend_->preprocess(scan, scan_motion, undistort);
-  out.non_finite_points += backend_->non_finite_points();  // those the backend screened itself
+  out.non_finite_points += backend_->non_finite_points();
 }
 
 map::PointLimit ScanPipeline::build_source(FrameResult& out) {

@@ -70,4 +70,14 @@ void downsampling_keys(const Vec3f* points, std::size_t n, const PreprocessParam
   for (; i < n; ++i) keys[i] = downsampling_key(points[i], pp);
 }
 
+std::size_t drop_non_finite(const Vec3f* points, const float* times, std::size_t n, std::uint64_t* keys) {
+  std::size_t dropped = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (finite_point(points[i], times ? times + i : nullptr)) continue;
+    keys[i] = map::kEmptyKey;
+    ++dropped;
+  }
+  return dropped;
+}
+
 }  // namespace farlio::preprocess

@@ -15,4 +15,9 @@ namespace farlio::preprocess {
 /// keys[i] = downsampling_key(points[i], pp) for i in [0, n).
 void downsampling_keys(const Vec3f* points, std::size_t n, const PreprocessParams& pp, std::uint64_t* keys);
 
+/// keys[i] = map::kEmptyKey for each point that finite_point rejects (`times`: the points' times,
+/// or null for a scan without them); returns how many. Run on the block downsampling_keys has
+/// just read, it screens the scan without another pass over it from memory.
+std::size_t drop_non_finite(const Vec3f* points, const float* times, std::size_t n, std::uint64_t* keys);
+
 }  // namespace farlio::preprocess
