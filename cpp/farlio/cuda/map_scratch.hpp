@@ -29,7 +29,7 @@ struct MapScratch {
   DeviceBuffer<std::int32_t> group_start;  ///< sorted position of each group's first key, then the end
   DeviceBuffer<std::int32_t> group_voxel, missing, rank, first_new;
   DeviceBuffer<map::GroupStats> group_stats;
-  DeviceBuffer<std::int32_t> scalars;  ///< small device-side results (see map_scratch.cu)
+  DeviceBuffer<std::int32_t> scalars;  ///< small device-side results (positions below)
 
   [[nodiscard]] std::size_t memory_bytes() const;
 };
