@@ -393,10 +393,9 @@ void DeviceVoxelMap::num_points_async() {
       &device_counts_.data()->points);
 }
 
-std::size_t DeviceVoxelMap::num_points() const {
-  const std::int32_t* counts = voxel_counts_.data();
-  return static_cast<std::size_t>(executor_->reduce(
-      high_water_, 0LL, [=] __device__(std::size_t i) { return static_cast<long long>(counts[i]); }, Add{}));
+std::size_t DeviceVoxelMap::num_points() {
+  num_points_async();
+  return read_results().points;
 }
 
 void DeviceVoxelMap::gather_async(Eigen::Vector4f* out_points, map::Cov3* out_covs, std::size_t capacity,

@@ -108,6 +108,7 @@ class DeviceVoxelMap {
   [[nodiscard]] double mean_points_per_voxel(const Eigen::Vector3f& origin, double range_m);
   /// The points stored, counted on the device (settle()'s `points`).
   void num_points_async();
+  [[nodiscard]] std::size_t num_points();
   /// Copies the stored points and covariances in pool order into device arrays of `capacity`
   /// elements; settle() throws CapacityError naming `parameter` when there are more (none is
   /// written beyond) and returns how many.
@@ -129,7 +130,6 @@ class DeviceVoxelMap {
   [[nodiscard]] map::ConstMapView view() const;
   [[nodiscard]] float spacing_m() const { return spacing_m_; }
   [[nodiscard]] std::size_t num_voxels() const { return live_voxels_; }
-  [[nodiscard]] std::size_t num_points() const;
   [[nodiscard]] std::size_t voxel_capacity() const { return capacity_; }
   [[nodiscard]] std::size_t memory_bytes() const;
   /// A host copy of voxels [0, high water).
