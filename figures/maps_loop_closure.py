@@ -11,6 +11,8 @@ printing
                           at least 2 submap lengths earlier) that lies within loop.submap_length_m
                           of an accepted loop's query keyframe
   verify s, graph s        time spent verifying candidates, and in the pose graph's updates (iSAM2)
+  along / across / up m   the global trajectory's error after the APE's alignment, RMS along the
+                          body's axes (x forward, y left, z up of the true pose)
 
 With --handover, instead: keyframes HANDOVER_SEPARATION_M apart along the path (every
 HANDOVER_STRIDE-th keyframe against the first one far enough back) are handed to the verification
@@ -33,7 +35,7 @@ from pathlib import Path
 
 import numpy as np
 from farlio import _core
-from farlio.loop_closure import LOOPS_CSV, MIN_LOOP_TRAVEL_FACTOR, LoopClosure
+from farlio.loop_closure import LOOPS_CSV, MIN_LOOP_TRAVEL_FACTOR, SCANS_BODY_GLOBAL_TUM, LoopClosure
 from farlio.mapping import MapOptions
 from harness import GeneratedDataset, ape_m, config, fixed_latency, generated_dataset, run, table_row
 from scipy.spatial.transform import Rotation  # xyzw quaternions, as loops.csv
@@ -42,7 +44,16 @@ CORRECT_LOOP_M, CORRECT_LOOP_DEG = 0.5, 1.0
 REVISIT_M = 5.0
 HANDOVER_SEPARATION_M, HANDOVER_STRIDE = (60.0, 200.0), 10
 #: the columns of a handed-over pair
-HANDOVER_COLUMNS = ("query", "match", "separation m", "overlap", "ambiguity m", "error vs truth m", "verdict")
+HANDOVER_COLUMNS = (
+    "query",
+    "match",
+    "separation m",
+    "overlap",
+    "ambiguity m",
+    "stalled starts",
+    "error vs truth m",
+    "verdict",
+)
 #: the columns of a run's row
 COLUMNS = (
     "seed",
@@ -53,6 +64,7 @@ COLUMNS = (
     "recall",
     "verify s",
     "graph s",
+    "along / across / up m",
 )
 
 
@@ -93,6 +105,22 @@ def precision_recall(gen, loops_csv: Path, submap_length_m: float) -> tuple[floa
     return precision, recall
 
 
+def error_axes(gen, tum: Path) -> np.ndarray:
+    """RMS (m) along the true body's x, y, z of the error of a body trajectory after the rigid
+    alignment (Umeyama, no scale) that the APE uses."""
+    truth = {s: p.matrix() for s, p in gen.groundtruth_scans()}
+    est = _core.io.read_trajectory(tum)
+    pairs = [(est[i][1].translation, truth[est[i][0]]) for i in range(len(est)) if est[i][0] in truth]
+    P = np.array([p for p, _ in pairs])
+    Q = np.array([T[:3, 3] for _, T in pairs])
+    mp, mq = P.mean(0), Q.mean(0)
+    U, _, Vt = np.linalg.svd((Q - mq).T @ (P - mp))
+    D = np.diag([1.0, 1.0, np.sign(np.linalg.det(U @ Vt))])
+    error = (U @ D @ Vt @ (P - mp).T).T + mq - Q
+    body = np.einsum("nji,nj->ni", np.array([T[:3, :3] for _, T in pairs]), error)
+    return np.sqrt((body**2).mean(axis=0))
+
+
 def handover(ds: GeneratedDataset, cfg) -> None:
     """Different places handed over as one (see the module doc)."""
     odo = _core.Odometry(cfg, ds.T_imu_lidar(), ds.gravity_m_s2(), ds.imu(), fixed_latency())
@@ -117,14 +145,11 @@ def handover(ds: GeneratedDataset, cfg) -> None:
         if not far:
             continue
         j = far[-1]
-        T, overlap, ambiguity, reason = loops.check(k, j, np.eye(4))
-        error = np.linalg.norm((np.linalg.inv(np.linalg.inv(at(kfs[j].stamp_ns)) @ at(kfs[k].stamp_ns)) @ T)[:3, 3])
+        c = loops.check(k, j, np.eye(4))
+        error = np.linalg.norm((np.linalg.inv(np.linalg.inv(at(kfs[j].stamp_ns)) @ at(kfs[k].stamp_ns)) @ c.T)[:3, 3])
         separation = kfs[k].path_m - kfs[j].path_m
-        print(
-            table_row(
-                k, j, f"{separation:.0f}", f"{overlap:.2f}", f"{ambiguity:.2f}", f"{error:.2f}", reason or "accepted"
-            )
-        )
+        cells = (f"{separation:.0f}", f"{c.overlap:.2f}", f"{c.ambiguity_m:.2f}", c.stalled_starts, f"{error:.2f}")
+        print(table_row(k, j, *cells, c.reason or "accepted"))
 
 
 def main() -> None:
@@ -157,7 +182,8 @@ def main() -> None:
         precision, recall = precision_recall(ds.gen, out / f"run-{seed}" / LOOPS_CSV, cfg.get("loop.submap_length_m"))
         cells = [f"{ape_m(s['accuracy']):.3f}", f"{ape_m(s['accuracy_global']):.3f}"]
         cells += [f"{lc['accepted']} / {lc['candidates']}", f"{precision:.2f}", f"{recall:.2f}"]
-        print(table_row(seed, *cells, f"{lc['verify_s']:.1f}", f"{lc['graph_s']:.2f}"), flush=True)
+        axes = " / ".join(f"{v:.2f}" for v in error_axes(ds.gen, out / f"run-{seed}" / SCANS_BODY_GLOBAL_TUM))
+        print(table_row(seed, *cells, f"{lc['verify_s']:.1f}", f"{lc['graph_s']:.2f}", axes), flush=True)
     print(f"outputs in {out}")
 
 

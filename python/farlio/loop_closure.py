@@ -13,9 +13,10 @@ loop.submap_length_m of path before it. When a keyframe's segment is complete:
    query's submap against the candidate's (and its neighbours'), accepted only when
    - at least loop.min_overlap of the query's cells land on the candidate's map, and
    - the same registration started AMBIGUITY_OFFSET_M away along each horizontal axis (and
-     AMBIGUITY_YAW_RAD turned) comes back within loop.max_ambiguity_m of the same pose: a straight
-     with evenly spaced posts or two identical corridors let a registration lock onto the wrong
-     copy, and then the starts disagree;
+     AMBIGUITY_YAW_RAD turned) comes back within loop.max_ambiguity_m of the same pose, or ends
+     at a clearly worse fit: a straight with evenly spaced posts or two identical corridors let
+     a registration lock onto the wrong copy, which fits as well, and then the starts disagree.
+     A start that stalls in a local minimum (still turned, and a clearly worse fit) is no rival;
 3. the pose graph (pose_graph.py) gets the loop edge and is optimised (iSAM2).
 
 After a loop is accepted the next loop.submap_length_m of travel is not searched (one loop per
@@ -63,6 +64,12 @@ STAGE_SIGMAS_M = (3.0, 1.0, 0.3)
 AMBIGUITY_OFFSET_M = 4.0
 #: and turned by this much about the vertical, rad (10 deg)
 AMBIGUITY_YAW_RAD = math.radians(10.0)
+#: a start stalled in a local minimum (a 10 deg turn is 7 m at the far end of a 40 m submap) is no
+#: rival of the found pose: it kept more than this fraction of its start's turn, and fits clearly
+#: worse, with less than AMBIGUITY_MIN_FIT of the found pose's inliers (15-30 % on the racetrack).
+#: Along a featureless straight a start shifted along it keeps its shift but turns back, and counts
+AMBIGUITY_STALLED_TURN = 0.5
+AMBIGUITY_MIN_FIT = 0.8
 #: overlap: cells of this many export resolutions
 OVERLAP_CELL_FACTOR = 2.0
 #: standard deviations of an accepted loop edge (translation m, rotation rad)
@@ -80,7 +87,8 @@ class Keyframe:
     stamp_ns: int
     scans: list[tuple[int, np.ndarray]] = field(default_factory=list)
     points: np.ndarray | None = None  # (N, 3) float32 once the segment is complete
-    export: Any = None  # the segment under construction (_core.MapExport)
+    export: Any = None  # the segment under construction from raw scans (_core.MapExport)
+    chunks: list[np.ndarray] = field(default_factory=list)  # or from registered points (its frame)
 
 
 @dataclass
@@ -95,7 +103,8 @@ class LoopRecord:
     overlap: float
     correction_m: float  # the verified pose against the graph's guess
     correction_deg: float
-    ambiguity_m: float  # largest disagreement of the ambiguity check's starts
+    ambiguity_m: float  # largest disagreement of the ambiguity check's rival ends
+    stalled_starts: int  # the ambiguity check's starts that ended at a clearly worse fit
     accepted: bool
     reason: str  # why it was refused ('' when accepted)
     time_s: float
@@ -115,6 +124,19 @@ LOOPS_CSV_FIELDS = [name for name in LoopRecord.__dataclass_fields__ if name != 
 LOOPS_CSV_COLUMNS = LOOPS_CSV_FIELDS + ["tx", "ty", "tz", "qx", "qy", "qz", "qw"]
 
 
+@dataclass
+class Check:
+    """A candidate's verification: the registered pose T_match_query, the share of the query's cells
+    on the match's map, the largest disagreement of the ambiguity test's rival ends (m), its starts
+    that stalled at a worse fit, and why it is refused ('' for a loop)."""
+
+    T: np.ndarray
+    overlap: float = 0.0
+    ambiguity_m: float = math.nan
+    stalled_starts: int = 0
+    reason: str = ""
+
+
 def _se3(m: np.ndarray) -> Any:
     return _core.SE3.from_matrix(np.asarray(m, dtype=np.float64))
 
@@ -127,6 +149,15 @@ def _cell_keys(points: np.ndarray, cell_m: float) -> np.ndarray:
     """One int64 per cell of cell_m (21 bits an axis, as the voxel keys)."""
     k = np.floor(points / cell_m).astype(np.int64) + (1 << 20)
     return (k[:, 0] << 42) | (k[:, 1] << 21) | k[:, 2]
+
+
+def _thinned(chunks: list[np.ndarray], cell_m: float) -> np.ndarray:
+    """The points of `chunks`, one per cell of cell_m (the first in it)."""
+    if not chunks:
+        return np.zeros((0, 3), np.float32)
+    points = np.concatenate(chunks)
+    _, first = np.unique(_cell_keys(points, cell_m), return_index=True)
+    return points[np.sort(first)]
 
 
 def _yaw_offset(dx: float, dy: float, yaw: float) -> np.ndarray:
@@ -169,27 +200,44 @@ class LoopClosure:
 
     # ---- keyframes ---------------------------------------------------------------------------
     def add(self, odo: Any, scan: Any, result: Any) -> None:
-        """A scan whose pose the odometry used (FrameResult result, the LiDAR pose at its end)."""
-        T = result.pose.matrix()
-        if self.last_position is not None:
-            self.path_m += float(np.linalg.norm(T[:3, 3] - self.last_position))
-        self.last_position = T[:3, 3].copy()
+        """A scan whose pose the odometry used (FrameResult result, the LiDAR pose at its end): its
+        points undistorted again with the motion the odometry used, at the export resolution."""
         if self.resolution_m is None:
             self.resolution_m = _core.export_resolution_m(odo.effective_config)
-        kf = self.keyframes[-1] if self.keyframes else None
-        if kf is None or np.linalg.norm(T[:3, 3] - kf.T_odom[:3, 3]) > self.keyframe_distance_m:
-            kf = self.start_keyframe(odo, T, result.stamp_ns)
+        T = result.pose.matrix()
+        kf = self.keyframe_for(T, result.stamp_ns)
+        if kf.export is None:
+            kf.export = _core.MapExport(self.resolution_m, odo.effective_config, "")
         T_kf_lidar = np.linalg.inv(kf.T_odom) @ T
         kf.export.add(scan, result, _se3(T_kf_lidar))
         kf.scans.append((result.stamp_ns, T_kf_lidar))
 
-    def start_keyframe(self, odo: Any, T: np.ndarray, stamp_ns: int) -> Keyframe:
+    def add_registered(self, stamp_ns: int, T_lidar: np.ndarray, points: np.ndarray) -> None:
+        """A scan as the online odometry registered it: its LiDAR pose T_lidar (4x4, the odometry's
+        frame) and its undistorted points in that frame ((N, 3), OdometryFrame.registered_points).
+        resolution_m must be set (the segments are thinned to it when they close)."""
+        kf = self.keyframe_for(T_lidar, stamp_ns)
+        G_inv = np.linalg.inv(kf.T_odom)
+        kf.chunks.append(_transform(np.asarray(points, dtype=np.float32), G_inv))
+        kf.scans.append((stamp_ns, G_inv @ T_lidar))
+
+    def keyframe_for(self, T: np.ndarray, stamp_ns: int) -> Keyframe:
+        """The keyframe a scan at the odometry's LiDAR pose T belongs to: the current one, or a new
+        one (the current segment closed and searched) once T is keyframe_distance_m from it."""
+        if self.last_position is not None:
+            self.path_m += float(np.linalg.norm(T[:3, 3] - self.last_position))
+        self.last_position = T[:3, 3].copy()
+        kf = self.keyframes[-1] if self.keyframes else None
+        if kf is None or np.linalg.norm(T[:3, 3] - kf.T_odom[:3, 3]) > self.keyframe_distance_m:
+            kf = self.start_keyframe(T, stamp_ns)
+        return kf
+
+    def start_keyframe(self, T: np.ndarray, stamp_ns: int) -> Keyframe:
         """Closes the current keyframe's segment (and searches for its loop), then starts one at T."""
         if self.keyframes:
             self.close_segment()
         previous = self.keyframes[-1] if self.keyframes else None
         kf = Keyframe(T, self.path_m, stamp_ns)
-        kf.export = _core.MapExport(self.resolution_m, odo.effective_config, "")
         self.keyframes.append(kf)
         start = time.perf_counter()
         self.graph.add_keyframe(T, self.path_m - previous.path_m if previous else 0.0)
@@ -198,8 +246,11 @@ class LoopClosure:
 
     def close_segment(self) -> None:
         kf = self.keyframes[-1]
-        kf.points = np.asarray(kf.export.points().points, dtype=np.float32)
-        kf.export = None
+        if kf.export is not None:
+            kf.points = np.asarray(kf.export.points().points, dtype=np.float32)
+        else:
+            kf.points = _thinned(kf.chunks, self.resolution_m)
+        kf.export, kf.chunks = None, []
         self.search(len(self.keyframes) - 1)
 
     def submap(self, k: int, first: int, last: int) -> np.ndarray:
@@ -238,36 +289,38 @@ class LoopClosure:
         if best is not None:
             self.verify(k, best, best_d)
 
-    def register(self, source: np.ndarray, target: np.ndarray, guess: np.ndarray) -> np.ndarray:
-        """T_target_source by GICP, coarse to fine from guess."""
+    def register(self, source: np.ndarray, target: np.ndarray, guess: np.ndarray) -> tuple[np.ndarray, int]:
+        """T_target_source by GICP, coarse to fine from guess, and the last stage's inliers."""
         src, tgt = farlio.Scan(source), farlio.Scan(target)
-        T = guess
+        T, inliers = guess, 0
         for c in self.stage_configs:
-            T = _core.register_pair(src, tgt, _se3(T), c).pose.matrix()
-        return T
+            result = _core.register_pair(src, tgt, _se3(T), c)
+            T, inliers = result.pose.matrix(), result.inliers
+        return T, inliers
 
-    def check(self, k: int, j: int, guess: np.ndarray) -> tuple[np.ndarray, float, float, str]:
+    def check(self, k: int, j: int, guess: np.ndarray) -> Check:
         """Registers keyframe k's submap onto j's neighbourhood from guess (T_j_k): the pose found,
-        the overlap, the ambiguity (m) and why it is refused ('' when it is a loop)."""
+        the overlap, the ambiguity and why it is refused ('' when it is a loop)."""
         source = self.submap(k, self.segments_back(k), k)
         j_first = self.segments_back(j)
         target = self.submap(j, j_first, j + (j - j_first))
-        T = self.register(source, target, guess)
+        T, inliers = self.register(source, target, guess)
         if not np.all(np.isfinite(T)):
-            return T, 0.0, math.nan, "registration failed"
+            return Check(T, reason="registration failed")
         overlap = self.overlap(_transform(source, T), target)
         if overlap < self.min_overlap:
-            return T, overlap, math.nan, f"overlap {overlap:.2f} < loop.min_overlap {self.min_overlap}"
-        ambiguity = self.ambiguity(source, target, T)
+            return Check(T, overlap, reason=f"overlap {overlap:.2f} < loop.min_overlap {self.min_overlap}")
+        ambiguity, stalled = self.ambiguity(source, target, T, inliers)
         if ambiguity > self.max_ambiguity_m:
-            return T, overlap, ambiguity, f"{AMBIGUOUS}: starts nearby end {ambiguity:.2f} m apart"
-        return T, overlap, ambiguity, ""
+            return Check(T, overlap, ambiguity, stalled, f"{AMBIGUOUS}: starts nearby end {ambiguity:.2f} m apart")
+        return Check(T, overlap, ambiguity, stalled)
 
     def verify(self, k: int, j: int, distance_m: float) -> None:
         """Checks the candidate from the graph's guess; a loop edge when it passes."""
         start = time.perf_counter()
         guess = np.linalg.inv(self.graph.pose(j)) @ self.graph.pose(k)
-        T, overlap, ambiguity, reason = self.check(k, j, guess)
+        c = self.check(k, j, guess)
+        T, reason = c.T, c.reason
         if reason.startswith(AMBIGUOUS):
             self.quiet_until_m = self.keyframes[k].path_m + RETRY_AFTER_AMBIGUOUS * self.submap_length_m
         if not reason:
@@ -286,10 +339,11 @@ class LoopClosure:
                 self.keyframes[k].stamp_ns,
                 self.keyframes[j].stamp_ns,
                 distance_m,
-                overlap,
+                c.overlap,
                 float(np.linalg.norm(correction[:3, 3])),
                 math.degrees(_se3(correction).angle_rad()) if np.all(np.isfinite(correction)) else math.nan,
-                ambiguity,
+                c.ambiguity_m,
+                c.stalled_starts,
                 not reason,
                 reason,
                 elapsed,
@@ -305,8 +359,9 @@ class LoopClosure:
         s = np.unique(_cell_keys(source_in_target, cell))
         return float(np.isin(s, np.unique(_cell_keys(target, cell))).mean())
 
-    def ambiguity(self, source: np.ndarray, target: np.ndarray, T: np.ndarray) -> float:
-        """The largest distance from T of the registrations started around it."""
+    def ambiguity(self, source: np.ndarray, target: np.ndarray, T: np.ndarray, inliers: int) -> tuple[float, int]:
+        """The largest distance from T (found with `inliers`) of the registrations started around it
+        that fit about as well (their rival ends), and how many starts ended at a clearly worse fit."""
         starts = [
             T @ _yaw_offset(dx, dy, yaw)
             for dx, dy, yaw in (
@@ -318,16 +373,30 @@ class LoopClosure:
         ]
         with ThreadPoolExecutor(self.workers) as pool:  # register_pair releases the GIL
             ends = list(pool.map(lambda start: self.register(source, target, start), starts))
-        worst = 0.0
-        for Ti in ends:
-            worst = max(worst, float(np.linalg.norm(Ti[:3, 3] - T[:3, 3])) if np.all(np.isfinite(Ti)) else math.inf)
-        return worst
+        worst, stalled = 0.0, 0
+        for Ti, end_inliers in ends:
+            if not np.all(np.isfinite(Ti)):
+                return math.inf, stalled
+            turned_rad = _se3(np.linalg.inv(T) @ Ti).angle_rad()
+            if turned_rad > AMBIGUITY_STALLED_TURN * AMBIGUITY_YAW_RAD and end_inliers < AMBIGUITY_MIN_FIT * inliers:
+                stalled += 1
+                continue
+            worst = max(worst, float(np.linalg.norm(Ti[:3, 3] - T[:3, 3])))
+        return worst, stalled
 
     # ---- results ------------------------------------------------------------------------------
     def finish(self) -> None:
         """Closes the last segment (and searches for its loop)."""
-        if self.keyframes and self.keyframes[-1].export is not None:
+        if self.keyframes and self.keyframes[-1].points is None:
             self.close_segment()
+
+    def map_from_odometry(self) -> np.ndarray:
+        """The correction from the odometry's frame to the global one (REP 105's map -> odom), 4x4:
+        the newest keyframe's global pose times the inverse of its odometry pose."""
+        if not self.keyframes:
+            return np.eye(4)
+        k = len(self.keyframes) - 1
+        return self.graph.pose(k) @ np.linalg.inv(self.keyframes[k].T_odom)
 
     def global_lidar_poses(self) -> list[tuple[int, np.ndarray]]:
         """Every scan's LiDAR pose in the global frame (its keyframe's optimised pose)."""
