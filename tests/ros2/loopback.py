@@ -21,6 +21,8 @@ POLL_S = 0.02
 #: want every scan (the real-time rate is measured by figures/ros2_latency.py)
 PLAY_RATE = 0.5
 OUTPUTS = ("odometry", "scan_odometry", "cloud_registered", "diagnostics")
+#: outputs published transient local (a late subscriber gets the last one)
+LATCHED_OUTPUTS = ("global_map",)
 
 
 def farlio_command(*args: str) -> list[str]:
@@ -88,19 +90,30 @@ class Recorder:
     """Subscribes to the node's outputs (reliable) and keeps (arrival monotonic ns, message); spins
     in a thread of its own."""
 
-    def __init__(self, rclpy: Any, node_name: str = "farlio"):
+    def __init__(self, rclpy: Any, node_name: str = "farlio", extra: tuple[str, ...] = ()):
+        """`extra`: outputs recorded besides OUTPUTS, of EXTRA_TYPES (latched ones transient local)."""
         from diagnostic_msgs.msg import DiagnosticArray
         from nav_msgs.msg import Odometry
         from rclpy.executors import SingleThreadedExecutor
-        from rclpy.qos import QoSProfile, ReliabilityPolicy
+        from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
         from sensor_msgs.msg import PointCloud2
 
         self.node = rclpy.create_node(f"farlio_test_recorder_{random.randint(0, 1 << 30)}")
         qos = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
         types = {"odometry": Odometry, "scan_odometry": Odometry, "cloud_registered": PointCloud2}
         types["diagnostics"] = DiagnosticArray
-        self.msgs: dict[str, list[tuple[int, Any]]] = {k: [] for k in OUTPUTS}
-        self.subs = [self.node.create_subscription(types[k], f"/{node_name}/{k}", self._keep(k), qos) for k in OUTPUTS]
+        types.update({"global_odometry": Odometry, "global_map": PointCloud2})
+        latched = QoSProfile(
+            depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
+        )
+        outputs = OUTPUTS + tuple(extra)
+        self.msgs: dict[str, list[tuple[int, Any]]] = {k: [] for k in outputs}
+        self.subs = [
+            self.node.create_subscription(
+                types[k], f"/{node_name}/{k}", self._keep(k), latched if k in LATCHED_OUTPUTS else qos
+            )
+            for k in outputs
+        ]
         self.executor = SingleThreadedExecutor()
         self.executor.add_node(self.node)
         self._thread = threading.Thread(target=self.executor.spin, daemon=True)

@@ -14,7 +14,7 @@ import sys
 import threading
 import time
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import rclpy
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
@@ -35,6 +35,9 @@ from ..datasets.calib import CalibFile
 from . import conversions as conv
 from . import retain_freed_memory
 from .live import FrameReport, LiveOdometry
+
+if TYPE_CHECKING:
+    from farlio.live_loop_closure import LiveLoopClosure
 from .params import NODE_NAME, NodeParams, config_from, config_param_docs, node_param_docs, node_params_from
 
 try:  # not on PyPI: present where ROS 2 is installed from its Debian packages
@@ -66,13 +69,15 @@ class FarlioNode(Node):
             extrinsics,
             gravity,
             warn=self.get_logger().warning,
-            keep_registered_points=self.params.publish_cloud_registered,
+            keep_registered_points=self.params.publish_cloud_registered or self.params.loop_closure,
         )
+        self.loops = self._loop_closure(extrinsics[0])
         self._gyro_bias = [0.0, 0.0, 0.0]
         # the odometry messages, filled again for every pose: one for the executor thread (fused
         # odometry), one for the result thread (scan odometry, and the odometry when LiDAR-only)
         self._fused_out = conv.ReusedOdometry(self.params.odom_frame, self.params.base_frame)
         self._scan_out = conv.ReusedOdometry(self.params.odom_frame, self.params.base_frame)
+        self._global_out = conv.ReusedOdometry(self.params.map_frame, self.params.base_frame)
         self._map_frames = 0  # processed frames when the local map was last published
         self._last_map_ns = 0
         self._make_publishers()
@@ -91,7 +96,21 @@ class FarlioNode(Node):
             f"farlio on {self.live.odometry.device}: IMU {imu}, LiDAR {', '.join(p.lidar_topics)}, "
             f"frames {p.odom_frame} -> {p.base_frame}, time offset {p.time_offset_s} s, "
             f"{'TF on /tf' if self._tf_pub else 'no /tf (tf2_msgs is not installed)'}"
+            + (f", loop closure in {p.map_frame}" if self.loops else "")
         )
+
+    def _loop_closure(self, T_imu_lidar: farlio.SE3) -> LiveLoopClosure | None:
+        """The loop closure's back end (parameter loop_closure), or None; stops the node at start
+        with the extra to install when gtsam is missing."""
+        if not self.params.loop_closure:
+            return None
+        from farlio.live_loop_closure import LiveLoopClosure
+
+        resolution = _core.export_resolution_m(self.config)
+        try:
+            return LiveLoopClosure(self.config, T_imu_lidar, resolution, self.params.global_map_period_s)
+        except ImportError as e:  # an expected error of `farlio ros2`: one line, no traceback
+            raise RuntimeError(f"loop_closure: {e}") from None
 
     # --- parameters and calibration ------------------------------------------------------------
     def _declare_and_read(self) -> tuple[NodeParams, farlio.Config]:
@@ -127,6 +146,9 @@ class FarlioNode(Node):
         latched = QoSProfile(depth=1, reliability=reliable, durability=DurabilityPolicy.TRANSIENT_LOCAL)
         self._map_pub = self.create_publisher(PointCloud2, "~/local_map", latched)
         self._diag_pub = self.create_publisher(DiagnosticArray, "~/diagnostics", DIAGNOSTICS_DEPTH)
+        if self.params.loop_closure:
+            self._global_pub = self.create_publisher(Odometry, "~/global_odometry", ODOMETRY_DEPTH)
+            self._global_map_pub = self.create_publisher(PointCloud2, "~/global_map", latched)
         self._tf_pub = (
             self.create_publisher(TFMessage, "/tf", ODOMETRY_DEPTH)
             if TFMessage is not None and self.params.publish_tf
@@ -184,7 +206,9 @@ class FarlioNode(Node):
             try:
                 for report in self.live.wait_frames(RESULT_WAIT_S):
                     self._publish_frame(report)
+                    self._publish_global(report.frame)
                 self._publish_local_map()
+                self._publish_global_map()
             except Exception as e:  # a publisher of a context shut down under us: stop quietly
                 if not self._stopping.is_set() and rclpy.ok():
                     self.get_logger().error(f"result thread: {type(e).__name__}: {e}")
@@ -208,6 +232,26 @@ class FarlioNode(Node):
         if stats is not None:
             self._gyro_bias = list(stats.gyro_bias_rad_s)
         self._diag_pub.publish(self._diagnostics(report))
+
+    def _publish_global(self, f: Any) -> None:
+        """With loop_closure: hands the registered scan to the back end (after the scan odometry is
+        out), then publishes the scan's global pose and map_frame -> odom_frame."""
+        if self.loops is None or not f.processed or f.scan.failure or f.scan.lost:
+            return
+        self.loops.submit(f.scan.stamp_ns, f.scan.pose.matrix(), f.registered_points)
+        stamp, p = f.scan.stamp_ns, self.params
+        correction = farlio.SE3.from_matrix(self.loops.map_from_odometry())
+        if self._global_out.fill(stamp, correction * f.body_pose):
+            self._global_pub.publish(self._global_out.msg)
+        if self._tf_pub is not None:
+            self._tf_pub.publish(
+                TFMessage(transforms=[conv.transform_msg(stamp, correction, p.map_frame, p.odom_frame)])
+            )
+
+    def _publish_global_map(self) -> None:
+        points = self.loops.take_global_map() if self.loops is not None else None
+        if points is not None and len(points):
+            self._global_map_pub.publish(conv.points_msg(points, self.live.last_scan_end or 0, self.params.map_frame))
 
     def _diagnostics(self, report: FrameReport) -> DiagnosticArray:
         f = report.frame
@@ -238,6 +282,8 @@ class FarlioNode(Node):
             "fusion_initialization": stats.initialization.mode if stats is not None else "",
             **self.live.stats.as_dict(),
         }
+        if self.loops is not None:
+            values.update({f"loop_{k}": v for k, v in vars(self.loops.stats()).items()})
         status.values = [KeyValue(key=k, value=str(v)) for k, v in values.items()]
         msg = DiagnosticArray(status=[status])
         msg.header.stamp = conv.to_stamp(r.stamp_ns)
@@ -287,6 +333,8 @@ class FarlioNode(Node):
         self._stopping.set()
         self._results.join()
         self.live.stop()
+        if self.loops is not None:
+            self.loops.stop(drain=False)
         counts = {k: v for k, v in self.live.stats.as_dict().items() if v}
         counts["scans_dropped_busy"] = self.live.odometry.scans_dropped_busy
         # printed: the context (and with it /rosout) is gone after SIGINT

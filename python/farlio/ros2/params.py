@@ -80,6 +80,15 @@ class NodeParams:
         "body pose at the first scan in odom_frame (the prior map's frame): X Y Z (m) ROLL PITCH YAW (deg); with an "
         "IMU roll and pitch come from gravity",
     )
+    loop_closure: bool = _param(
+        False,
+        "loop closure on a thread of its own (the back end of `farlio run --loop-closure`, loop.* parameters): "
+        "publishes map_frame -> odom_frame on /tf, global_odometry and global_map; needs gtsam (farlio[mapping])",
+    )
+    map_frame: str = _param("map", "with loop_closure: the global frame (REP 105's map), parent of odom_frame")
+    global_map_period_s: float = _param(
+        5.0, "with loop_closure: the shortest period of the global_map publication (transient local)"
+    )
 
     def time_options(self) -> TimeOptions:
         return TimeOptions(self.time_field, self.time_unit, self.header_stamp)
@@ -94,7 +103,13 @@ class NodeParams:
         for name in ("lidar_queue_depth", "imu_queue_depth"):
             if getattr(self, name) < 1:
                 raise ValueError(f"{name} {getattr(self, name)}: expected at least 1")
-        for name in ("imu_wait_s", "lidar_merge_wait_s", "silent_topic_timeout_s", "local_map_period_s"):
+        for name in (
+            "imu_wait_s",
+            "lidar_merge_wait_s",
+            "silent_topic_timeout_s",
+            "local_map_period_s",
+            "global_map_period_s",
+        ):
             if not getattr(self, name) >= 0:
                 raise ValueError(f"{name} {getattr(self, name)}: expected >= 0")
         if len(self.initial_pose) != 6 or not all(abs(v) < float("inf") for v in self.initial_pose):
