@@ -17,9 +17,14 @@ lap is ~7 GB of PCD). Prints per profile and pass seed:
 and the map's size, memory and export time per scan; writes error_over_time_<profile>.png (the
 error in the ground truth's frame over time, odometry vs localization) and maps.json into --out.
 
+With --global-map, a third mode per pass: localization in the global map of `farlio run
+--loop-closure --save-map` over a mapping run as long as a pass (map_global.pcd: every keyframe's
+segment at its loop-closed pose), against the single-pass map; its "vs map" columns compare with
+the mapping run's global poses (scans_body_global.tum).
+
 Usage: python figures/maps_localization.py [--profiles urban handheld racetrack] [--pass-seeds 2 3]
-       [--out DIR]
-Racetrack: the map is the first lap (85 s), each pass two laps (165 s).
+       [--global-map] [--out DIR]
+Racetrack: the map is the first lap (85 s), each pass two laps (165 s); the global map two laps.
 """
 
 from __future__ import annotations
@@ -30,7 +35,8 @@ from pathlib import Path
 
 import numpy as np
 from farlio import _core
-from farlio.mapping import MAP_PCD, MapOptions
+from farlio.loop_closure import SCANS_BODY_GLOBAL_TUM
+from farlio.mapping import MAP_GLOBAL_PCD, MAP_PCD, MapOptions
 from farlio.runner import SCANS_BODY_TUM
 from harness import ape_m, config, floats, generated_dataset, run, timing_rows, work_folder
 
@@ -61,27 +67,35 @@ def frame_stats(out: Path) -> tuple[float, float, float]:
     return float(np.median(ms)), float(np.percentile(ms, 99)), min(inliers, default=float("nan"))
 
 
-def measure(profile: str, pass_seeds: list[int], out: Path, work: Path) -> dict:
+def measure(profile: str, pass_seeds: list[int], out: Path, work: Path, global_map: bool = False) -> dict:
     map_s, pass_s = DURATIONS_S[profile]
     mapping = run(
         generated_dataset(profile, MAP_SEED, map_s, work), work / f"{profile}-map", config(), MapOptions(save=True)
     )
-    mapping_poses = poses(work / f"{profile}-map" / SCANS_BODY_TUM)
+    mapping_poses = {"localization": poses(work / f"{profile}-map" / SCANS_BODY_TUM)}
+    modes = [("odometry", MapOptions()), ("localization", MapOptions(prior_map=work / f"{profile}-map" / MAP_PCD))]
     result = {"map": mapping["map"], "mapping_ape_m": ape_m(mapping["accuracy"]), "passes": {}}
+    if global_map:
+        o = work / f"{profile}-map-global"
+        closed = run(
+            generated_dataset(profile, MAP_SEED, pass_s, work), o, config(), MapOptions(True, loop_closure=True)
+        )
+        mapping_poses["global map"] = poses(o / SCANS_BODY_GLOBAL_TUM)
+        modes.append(("global map", MapOptions(prior_map=o / MAP_GLOBAL_PCD)))
+        result["global_mapping_ape_m"] = ape_m(closed["accuracy_global"])
     curves = {}
     for seed in pass_seeds:
         row = {}
-        for mode, maps in (
-            ("odometry", MapOptions()),
-            ("localization", MapOptions(prior_map=work / f"{profile}-map" / MAP_PCD)),
-        ):
+        for mode, maps in modes:
             data = generated_dataset(profile, seed, pass_s, work)
-            o = work / f"{profile}-{seed}-{mode}"
+            o = work / f"{profile}-{seed}-{mode.replace(' ', '-')}"
             s = run(data, o, config(), maps)
             est, gt = poses(o / SCANS_BODY_TUM), poses(data.gt_scans)
-            t, err = error_in_gt_frame(est, gt, mapping_poses if mode == "localization" else est)
-            common = [k for k in sorted(est) if k in mapping_poses]
-            vs_map = np.array([np.linalg.norm(est[k][:3, 3] - mapping_poses[k][:3, 3]) for k in common])
+            frame = mapping_poses.get(mode, est)
+            t, err = error_in_gt_frame(est, gt, frame)
+            reference = mapping_poses.get(mode, mapping_poses["localization"])
+            common = [k for k in sorted(est) if k in reference]
+            vs_map = np.array([np.linalg.norm(est[k][:3, 3] - reference[k][:3, 3]) for k in common])
             t_map = (np.array(common) - common[0]) / 1e9
             med, p99, min_inliers = frame_stats(o)
             row[mode] = {
@@ -92,7 +106,7 @@ def measure(profile: str, pass_seeds: list[int], out: Path, work: Path) -> dict:
                 "frame_ms_median": med,
                 "frame_ms_p99": p99,
             }
-            if mode == "localization":
+            if mode != "odometry":
                 loc = s["localization"]
                 row[mode] |= {
                     "lost": loc["frames_lost"],
@@ -117,7 +131,9 @@ def plot_curves(profile: str, curves: dict, path: Path) -> None:
         (axes[1], "gt", "against the ground truth (aligned at the start)"),
     ):
         for i, (seed, modes) in enumerate(sorted(curves.items())):
-            for mode, style in (("odometry", "--"), ("localization", "-")):
+            for mode, style in (("odometry", "--"), ("localization", "-"), ("global map", ":")):
+                if mode not in modes:
+                    continue
                 t, err = modes[mode][key]
                 ax.plot(t, err, style, color=f"C{i}", label=f"{mode}, seed {seed}")
         ax.set_xlabel("time [s]")
@@ -135,19 +151,21 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--profiles", nargs="+", default=["urban", "handheld", "racetrack"], choices=list(DURATIONS_S))
     ap.add_argument("--pass-seeds", nargs="+", type=int, default=[2, 3])
+    ap.add_argument("--global-map", action="store_true", help="also localize in the loop-closed map (module doc)")
     ap.add_argument("--out", type=Path, default=Path("maps_measure"))
     args = ap.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     results = {}
     with work_folder(prefix="farlio-maps-") as tmp:
         for profile in args.profiles:
-            r = measure(profile, args.pass_seeds, args.out, tmp)
+            r = measure(profile, args.pass_seeds, args.out, tmp, args.global_map)
             results[profile] = r
             m = r["map"]
             print(
                 f"\n{profile}: map {m['points']} points at {m['resolution_m']:.2f} m, "
                 f"{m['memory_bytes'] / 2**20:.1f} MiB, export {m['add_ms_median']:.1f} ms/scan median; "
                 f"mapping run APE {r['mapping_ape_m']:.3f} m"
+                + (f", global {r['global_mapping_ape_m']:.3f} m" if "global_mapping_ape_m" in r else "")
             )
             print(f"{'seed':>4} {'mode':<13} {'APE m':>7} {'err end m':>9} {'vs map end':>10} {'vs map max':>10} "
                   f"{'lost':>5} {'min inl':>7} {'ms med':>7} {'ms p99':>7}")  # fmt: skip

@@ -35,6 +35,7 @@ from pathlib import Path
 
 import numpy as np
 from farlio import _core
+from farlio.evaluation import make_options
 from farlio.loop_closure import LOOPS_CSV, MIN_LOOP_TRAVEL_FACTOR, SCANS_BODY_GLOBAL_TUM, LoopClosure
 from farlio.mapping import MapOptions
 from harness import GeneratedDataset, ape_m, config, fixed_latency, generated_dataset, run, table_row
@@ -106,19 +107,20 @@ def precision_recall(gen, loops_csv: Path, submap_length_m: float) -> tuple[floa
 
 
 def error_axes(gen, tum: Path) -> np.ndarray:
-    """RMS (m) along the true body's x, y, z of the error of a body trajectory after the rigid
-    alignment (Umeyama, no scale) that the APE uses."""
-    truth = {s: p.matrix() for s, p in gen.groundtruth_scans()}
+    """RMS (m) along the true body's x, y, z of the error of a body trajectory after the APE's
+    alignment (the evaluation's own, without scale)."""
+    truth = _core.Trajectory()
+    for stamp, pose in gen.groundtruth_scans():
+        truth.push_back(stamp, pose)
     est = _core.io.read_trajectory(tum)
-    pairs = [(est[i][1].translation, truth[est[i][0]]) for i in range(len(est)) if est[i][0] in truth]
-    P = np.array([p for p, _ in pairs])
-    Q = np.array([T[:3, 3] for _, T in pairs])
-    mp, mq = P.mean(0), Q.mean(0)
-    U, _, Vt = np.linalg.svd((Q - mq).T @ (P - mp))
-    D = np.diag([1.0, 1.0, np.sign(np.linalg.det(U @ Vt))])
-    error = (U @ D @ Vt @ (P - mp).T).T + mq - Q
-    body = np.einsum("nji,nj->ni", np.array([T[:3, :3] for _, T in pairs]), error)
-    return np.sqrt((body**2).mean(axis=0))
+    align = _core.eval.evaluate(est, truth, make_options()).ape.alignment.transform
+    true_pose = {truth[i][0]: truth[i][1] for i in range(len(truth))}
+    body = [
+        true_pose[s].rotation().T @ ((align * p).translation - true_pose[s].translation)
+        for s, p in (est[i] for i in range(len(est)))
+        if s in true_pose
+    ]
+    return np.sqrt((np.array(body) ** 2).mean(axis=0))
 
 
 def handover(ds: GeneratedDataset, cfg) -> None:

@@ -13,7 +13,8 @@ to the CPU time of the same scans through farlio.OnlineOdometry alone (in this p
 the other), as a share of one core over the run.
 
 Run with .venv-ros: .venv-ros/bin/python figures/ros2_latency.py [--scans 100] [--input-qos best_effort]
-[--transport ros-default] [--json out.json]. Results: docs/ros2.md, "Latency and CPU".
+[--transport ros-default] [--param NAME:=VALUE ...] [--profile P --lidar L --lidar-rate HZ]
+[--json out.json]. Results: docs/ros2.md, "Latency and CPU".
 """
 
 from __future__ import annotations
@@ -84,6 +85,9 @@ def parse_args() -> argparse.Namespace:
     ap.add_argument("--input-qos", default="reliable", choices=["reliable", "best_effort"])
     ap.add_argument("--transport", default="large-data", choices=["large-data", "ros-default"])
     ap.add_argument("--param", action="append", default=[], metavar="NAME:=VALUE", help="a node parameter (repeatable)")
+    ap.add_argument("--profile", default="urban", help="the generated sequence's profile")
+    ap.add_argument("--lidar", default="profile", help="the simulator's LiDAR model (farlio simulate --lidar)")
+    ap.add_argument("--lidar-rate", type=float, default=10.0, help="LiDAR rate (Hz)")
     ap.add_argument("--json", type=Path, default=None)
     return ap.parse_args()
 
@@ -157,6 +161,10 @@ def summarise(got, played, lat: dict[str, list[float]], args, transport: str, cp
         "wall_s": wall_s,
         "node_cpu_core_share": cpu / wall_s,
         "pipeline_cpu_core_share": base_cpu / wall_s,
+        # with loop_closure: the back end's counters at the last scan (keyframes, loops, backlog)
+        "loop_closure": {k[len("loop_") :]: int(v) for k, v in diags[-1].items() if k.startswith("loop_")}
+        if diags
+        else {},
         "latency_ms": {
             k: dict(zip(("median", "p99"), np.percentile(v, PERCENTILES).tolist())) if v else None
             for k, v in lat.items()
@@ -181,6 +189,8 @@ def print_report(result: dict, played, lat: dict[str, list[float]]) -> None:
         ("e2e cloud->fused odometry", "e2e_fused"),
     ):
         print(f"  {name:30s} {stats(lat[key])}")
+    if result["loop_closure"]:
+        print("loop closure at the last scan: " + ", ".join(f"{k} {v}" for k, v in result["loop_closure"].items()))
     print(
         f"CPU (share of one core over {result['wall_s']:.1f} s): node {result['node_cpu_core_share']:.2f}, "
         f"OnlineOdometry alone on the same data {result['pipeline_cpu_core_share']:.2f}"
@@ -210,8 +220,14 @@ def measure(args: argparse.Namespace, tmp: Path) -> int:
     from farlio.simulation import generate
     from rclpy.executors import SingleThreadedExecutor
 
-    seq = tmp / "urban"
-    generate("urban", seq, duration_s=args.scans / 10 + 0.5)
+    seq = tmp / args.profile
+    generate(
+        args.profile,
+        seq,
+        duration_s=args.scans / args.lidar_rate + 0.5,
+        lidar=args.lidar,
+        lidar_rate_hz=args.lidar_rate,
+    )
     ds = open_dataset(seq)
     config_overrides = [p.replace(":=", "=", 1) for p in args.param if p.split(":=")[0] in farlio_fields()]
     base_cpu = pipeline_cpu_s(ds, args.scans, load_config(None, config_overrides))

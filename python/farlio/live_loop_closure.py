@@ -14,7 +14,9 @@ candidates and updates the graph; after every keyframe it publishes, under a sho
   global_map_period_s and only when a keyframe or a loop came since the last one;
 - `stats()`: keyframes, loops accepted and verified, the scans waiting, the scans dropped.
 
-The queue holds at most MAX_BACKLOG_SCANS scans; a scan arriving when it is full is dropped from
+The back end's threads run BACK_END_NICENESS nicer than the odometry's, so that on a machine
+with few cores a verification waits for the odometry rather than the other way round. The queue
+holds at most MAX_BACKLOG_SCANS scans; a scan arriving when it is full is dropped from
 the back end (counted; its keyframe's segment has fewer points), never from the odometry."""
 
 from __future__ import annotations
@@ -27,10 +29,13 @@ from typing import Any
 
 import numpy as np
 
-from .loop_closure import LoopClosure
+from .loop_closure import LoopClosure, lower_priority
 
 #: scans waiting for the back end (about 30 s of a 20 Hz LiDAR) before new ones are dropped from it
 MAX_BACKLOG_SCANS = 600
+#: the back end's threads run this much nicer than the odometry's (Linux): on a machine with few
+#: cores the odometry's worker takes a core first, and the verification waits
+BACK_END_NICENESS = 10
 #: how long the back end's thread waits for a scan before it looks at its stop flag (s)
 POLL_S = 0.1
 
@@ -50,7 +55,7 @@ class LiveLoopClosure:
     """LoopClosure on its own thread, fed with registered scans (see the module doc)."""
 
     def __init__(self, config: Any, T_imu_lidar: Any, resolution_m: float, global_map_period_s: float = 5.0):
-        self.loops = LoopClosure(config, T_imu_lidar)
+        self.loops = LoopClosure(config, T_imu_lidar, BACK_END_NICENESS)
         self.loops.resolution_m = resolution_m
         self.global_map_period_s = global_map_period_s
         self._queue: queue.Queue[tuple[int, np.ndarray, np.ndarray]] = queue.Queue(MAX_BACKLOG_SCANS)
@@ -88,6 +93,11 @@ class LiveLoopClosure:
             points, self._global_map = self._global_map, None
             return points
 
+    @property
+    def native_thread_id(self) -> int | None:
+        """The back end's thread as the OS knows it (for its priority, or a profiler)."""
+        return self._thread.native_id
+
     def stats(self) -> LoopStats:
         with self._lock:
             s = LoopStats(**vars(self._stats))
@@ -106,6 +116,7 @@ class LiveLoopClosure:
 
     # ---- the back end's thread ----------------------------------------------------------------
     def _run(self) -> None:
+        lower_priority(BACK_END_NICENESS)
         while not self._stop.is_set():
             try:
                 item = self._queue.get(timeout=POLL_S)

@@ -33,6 +33,7 @@ from __future__ import annotations
 import csv
 import math
 import os
+import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -151,6 +152,18 @@ def _cell_keys(points: np.ndarray, cell_m: float) -> np.ndarray:
     return (k[:, 0] << 42) | (k[:, 1] << 21) | k[:, 2]
 
 
+def lower_priority(niceness: int) -> None:
+    """Raises the calling thread's niceness by `niceness` (Linux: a thread is a schedulable task of
+    its own); nothing where that is not possible."""
+    if niceness <= 0 or not hasattr(os, "setpriority"):
+        return
+    tid = threading.get_native_id()
+    try:
+        os.setpriority(os.PRIO_PROCESS, tid, os.getpriority(os.PRIO_PROCESS, tid) + niceness)
+    except OSError:
+        pass
+
+
 def _thinned(chunks: list[np.ndarray], cell_m: float) -> np.ndarray:
     """The points of `chunks`, one per cell of cell_m (the first in it)."""
     if not chunks:
@@ -171,7 +184,9 @@ def _yaw_offset(dx: float, dy: float, yaw: float) -> np.ndarray:
 class LoopClosure:
     """Keyframes, loop detection and verification, and the pose graph of one run."""
 
-    def __init__(self, config: Any, T_imu_lidar: Any):
+    def __init__(self, config: Any, T_imu_lidar: Any, niceness: int = 0):
+        """niceness: added to the scheduling niceness of the threads that verify (Linux: per thread),
+        so that a live odometry beside them takes the cores first (LiveLoopClosure)."""
         self.config = config
         self.T_lidar_imu = np.linalg.inv(T_imu_lidar.matrix())
         self.keyframe_distance_m = config.get("loop.keyframe_distance_m")
@@ -189,6 +204,7 @@ class LoopClosure:
             c.set("threshold.initial_threshold_m", sigma)
             self.stage_configs.append(c)
         self.workers = config.get("num_threads") or os.cpu_count() or 1
+        self.niceness = niceness
         self.keyframes: list[Keyframe] = []
         self.records: list[LoopRecord] = []
         self.resolution_m: float | None = None
@@ -371,7 +387,8 @@ class LoopClosure:
                 (0.0, -AMBIGUITY_OFFSET_M, AMBIGUITY_YAW_RAD),
             )
         ]
-        with ThreadPoolExecutor(self.workers) as pool:  # register_pair releases the GIL
+        # register_pair releases the GIL
+        with ThreadPoolExecutor(self.workers, initializer=lower_priority, initargs=(self.niceness,)) as pool:
             ends = list(pool.map(lambda start: self.register(source, target, start), starts))
         worst, stalled = 0.0, 0
         for Ti, end_inliers in ends:

@@ -9,6 +9,9 @@ from __future__ import annotations
 
 import csv
 import math
+import os
+import threading
+import time
 
 import numpy as np
 import pytest
@@ -221,3 +224,21 @@ def test_the_live_back_end_closes_the_lap_beside_the_online_odometry():
     glob_ape = _core.eval.evaluate(glob, gt, options).ape.translation_m.rmse
     print("live: odometry APE", odo_ape, "global APE", glob_ape, "loops", len(accepted), "of", len(loops.records))
     assert glob_ape < 0.9 * odo_ape
+
+
+@pytest.mark.skipif(not hasattr(os, "setpriority"), reason="per-thread niceness is Linux's")
+def test_the_live_back_end_runs_nicer_than_the_odometry():
+    """Its thread (and the verification's, through the same lower_priority) yields the cores to the
+    odometry's: niceness raised by BACK_END_NICENESS, the caller's unchanged."""
+    from farlio.live_loop_closure import BACK_END_NICENESS, LiveLoopClosure
+
+    before = os.getpriority(os.PRIO_PROCESS, threading.get_native_id())
+    live = LiveLoopClosure(_core.Config(), _core.SE3(), 0.2)
+    try:
+        wait_s = time.monotonic() + 5.0
+        while os.getpriority(os.PRIO_PROCESS, live.native_thread_id) == before and time.monotonic() < wait_s:
+            time.sleep(0.01)
+        assert os.getpriority(os.PRIO_PROCESS, live.native_thread_id) == min(before + BACK_END_NICENESS, 19)
+        assert os.getpriority(os.PRIO_PROCESS, threading.get_native_id()) == before
+    finally:
+        live.stop()
