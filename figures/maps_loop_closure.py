@@ -4,7 +4,8 @@
 printing
 
   odometry / global APE   aligned translation RMSE of scans_body.tum / scans_body_global.tum (m)
-  accepted / verified     loops accepted and candidates verified (loops.csv)
+  accepted (in graph) / verified  loops accepted (of which added to the pose graph: the others agreed
+                          with its estimate within the loop edge's std) and candidates verified
   precision               accepted loops whose registered pose (loops.csv tx..qw) is within
                           CORRECT_LOOP_M and CORRECT_LOOP_DEG of the ground truth's relative pose
   recall                  the revisited path (scans within REVISIT_M of where the ground truth was
@@ -60,7 +61,7 @@ COLUMNS = (
     "seed",
     "odometry APE m",
     "global APE m",
-    "accepted / verified",
+    "accepted (in graph) / verified",
     "precision",
     "recall",
     "verify s",
@@ -183,7 +184,7 @@ def main() -> None:
         lc = s["loop_closure"]
         precision, recall = precision_recall(ds.gen, out / f"run-{seed}" / LOOPS_CSV, cfg.get("loop.submap_length_m"))
         cells = [f"{ape_m(s['accuracy']):.3f}", f"{ape_m(s['accuracy_global']):.3f}"]
-        cells += [f"{lc['accepted']} / {lc['candidates']}", f"{precision:.2f}", f"{recall:.2f}"]
+        cells += [f"{lc['accepted']} ({lc['in_graph']}) / {lc['candidates']}", f"{precision:.2f}", f"{recall:.2f}"]
         axes = " / ".join(f"{v:.2f}" for v in error_axes(ds.gen, out / f"run-{seed}" / SCANS_BODY_GLOBAL_TUM))
         print(table_row(seed, *cells, f"{lc['verify_s']:.1f}", f"{lc['graph_s']:.2f}", axes), flush=True)
     print(f"outputs in {out}")

@@ -17,7 +17,8 @@ loop.submap_length_m of path before it. When a keyframe's segment is complete:
      at a clearly worse fit: a straight with evenly spaced posts or two identical corridors let
      a registration lock onto the wrong copy, which fits as well, and then the starts disagree.
      A start that stalls in a local minimum (still turned, and a clearly worse fit) is no rival;
-3. the pose graph (pose_graph.py) gets the loop edge and is optimised (iSAM2).
+3. the pose graph (pose_graph.py) gets the loop edge and is optimised (iSAM2), unless the graph
+   already agrees with the loop within the loop edge's standard deviations (LOOP_SIGMA).
 
 After a loop is accepted the next loop.submap_length_m of travel is not searched (one loop per
 submap is enough to hold the graph, and verification is the expensive step), after a candidate
@@ -73,7 +74,8 @@ AMBIGUITY_STALLED_TURN = 0.5
 AMBIGUITY_MIN_FIT = 0.8
 #: overlap: cells of this many export resolutions
 OVERLAP_CELL_FACTOR = 2.0
-#: standard deviations of an accepted loop edge (translation m, rotation rad)
+#: standard deviations of an accepted loop edge (translation m, rotation rad); a loop whose pose is
+#: within both of the graph's estimate is accepted but not added (it would only add its error)
 LOOP_SIGMA = (0.05, math.radians(0.2))
 AMBIGUOUS = "ambiguous"
 
@@ -107,6 +109,7 @@ class LoopRecord:
     ambiguity_m: float  # largest disagreement of the ambiguity check's rival ends
     stalled_starts: int  # the ambiguity check's starts that ended at a clearly worse fit
     accepted: bool
+    in_graph: bool  # accepted and a pose-graph edge (not when the graph already agreed within LOOP_SIGMA)
     reason: str  # why it was refused ('' when accepted)
     time_s: float
     T_match_query: np.ndarray = field(default=None, repr=False)  # the registration's result
@@ -332,22 +335,29 @@ class LoopClosure:
         return Check(T, overlap, ambiguity, stalled)
 
     def verify(self, k: int, j: int, distance_m: float) -> None:
-        """Checks the candidate from the graph's guess; a loop edge when it passes."""
+        """Checks the candidate from the graph's guess; a loop edge when it passes and the graph does
+        not already agree with it (a loop within its own std of the estimate would only add its
+        error: the handheld walk's odometry is within 1 cm where a loop is within a few)."""
         start = time.perf_counter()
         guess = np.linalg.inv(self.graph.pose(j)) @ self.graph.pose(k)
         c = self.check(k, j, guess)
         T, reason = c.T, c.reason
+        correction = np.linalg.inv(guess) @ T if np.all(np.isfinite(T)) else np.full((4, 4), np.nan)
+        finite = bool(np.all(np.isfinite(correction)))
+        correction_m = float(np.linalg.norm(correction[:3, 3]))
+        correction_rad = _se3(correction).angle_rad() if finite else math.nan
         if reason.startswith(AMBIGUOUS):
             self.quiet_until_m = self.keyframes[k].path_m + RETRY_AFTER_AMBIGUOUS * self.submap_length_m
-        if not reason:
+        in_graph = not reason and not (correction_m < LOOP_SIGMA[0] and correction_rad < LOOP_SIGMA[1])
+        if in_graph:
             cov = np.diag([LOOP_SIGMA[1] ** 2] * 3 + [LOOP_SIGMA[0] ** 2] * 3)
             graph_start = time.perf_counter()
             self.graph.add_loop(j, k, T, cov)
             self.graph_s += time.perf_counter() - graph_start
+        if not reason:
             self.quiet_until_m = self.keyframes[k].path_m + self.submap_length_m
         elapsed = time.perf_counter() - start
         self.verify_s += elapsed
-        correction = np.linalg.inv(guess) @ T if np.all(np.isfinite(T)) else np.full((4, 4), np.nan)
         self.records.append(
             LoopRecord(
                 k,
@@ -356,11 +366,12 @@ class LoopClosure:
                 self.keyframes[j].stamp_ns,
                 distance_m,
                 c.overlap,
-                float(np.linalg.norm(correction[:3, 3])),
-                math.degrees(_se3(correction).angle_rad()) if np.all(np.isfinite(correction)) else math.nan,
+                correction_m,
+                math.degrees(correction_rad),
                 c.ambiguity_m,
                 c.stalled_starts,
                 not reason,
+                in_graph,
                 reason,
                 elapsed,
                 T,
@@ -453,6 +464,7 @@ class LoopClosure:
             "path_m": self.path_m,
             "candidates": len(self.records),
             "accepted": len(accepted),
+            "in_graph": sum(r.in_graph for r in accepted),
             "verify_s": self.verify_s,
             "graph_s": self.graph_s,
             "largest_correction_m": max((r.correction_m for r in accepted), default=0.0),

@@ -498,8 +498,9 @@ def format_summary(s: dict[str, Any]) -> str:
     if s.get("loop_closure"):
         lc = s["loop_closure"]
         lines.append(
-            f"loop closure: {lc['accepted']} of {lc['candidates']} verified loops accepted over {lc['keyframes']} "
-            f"keyframes (scans_body_global.tum, loops.csv), {lc['verify_s']:.1f} s verifying"
+            f"loop closure: {lc['accepted']} of {lc['candidates']} verified loops accepted ({lc['in_graph']} "
+            f"corrected the graph) over {lc['keyframes']} keyframes (scans_body_global.tum, loops.csv), "
+            f"{lc['verify_s']:.1f} s verifying"
         )
     for key, label in (
         ("accuracy", "scan poses"),

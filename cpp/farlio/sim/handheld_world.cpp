@@ -1,6 +1,7 @@
 // The handheld profile: a person walks with a hand-held 32-beam LiDAR through a furnished
 // room, a 60 m long featureless corridor (a degenerate case for registration: long uniform
-// walls) and a second room with pillars, stopping three times to look around quickly.
+// walls) and a second room with pillars, stopping three times to look around quickly, then back
+// through the corridor into the first room.
 #include <cmath>
 #include <numbers>
 
@@ -82,8 +83,9 @@ SmoothCurve look_around(const std::vector<std::pair<double, double>>& stops) {
 }  // namespace
 
 World build_handheld_world() {
-  const std::vector<Eigen::Vector2d> route = {{2, 1.5}, {8, 1.5}, {8, 6.5}, {2, 6.5}, {2, 4}, {77, 4},
-                                              {77, 10}, {82, 10}, {82, -2}, {72, -2}, {72, 1}};
+  // After room B the walk returns through the corridor into room A (~125 s in, for loop closure).
+  const std::vector<Eigen::Vector2d> route = {{2, 1.5}, {8, 1.5}, {8, 6.5}, {2, 6.5}, {2, 4}, {77, 4}, {77, 10},
+                                              {82, 10}, {82, -2}, {72, -2}, {72, 4},  {5, 4}, {5, 2}};
   Path path = Path::from_polyline(route, std::vector<double>(route.size() - 2, kTurnRadius_m), false);
   SpeedPlan plan(path, {kWalkSpeed_m_s, kMaxLateralAccel_m_s2, kMaxLongitudinalAccel_m_s2, kInitialRest_s},
                  {{0, kStopHold_s}, {4, kStopHold_s}, {7, kStopHold_s}});

@@ -1,6 +1,7 @@
 // The urban profile: a grid of city blocks on hilly ground (the height varies along x), with
 // buildings, parked cars, poles and trees; a car drives a route of straights and right-angle
-// turns with full stops; one 64-beam spinning LiDAR (mount_car_lidar, shared with the tunnel).
+// turns with full stops, closing a block at its end; one 64-beam spinning LiDAR (mount_car_lidar,
+// shared with the tunnel).
 #include <cmath>
 #include <numbers>
 
@@ -132,8 +133,10 @@ void add_street_furniture(Scene& scene, const GroundProfile& g, Rng& rng) {
 
 World build_urban_world() {
   const double b = kBlockPitch_m;
-  const std::vector<Eigen::Vector2d> route = {{0, 0},     {3 * b, 0},     {3 * b, 2 * b}, {b, 2 * b},
-                                              {b, 3 * b}, {4 * b, 3 * b}, {4 * b, -b},    {2 * b, -b}};
+  // The last two legs close a block: north onto the first street, then back along it to the start
+  // (a revisit in the opposite direction, ~160 s into the drive, for loop closure).
+  const std::vector<Eigen::Vector2d> route = {{0, 0},         {3 * b, 0},  {3 * b, 2 * b}, {b, 2 * b}, {b, 3 * b},
+                                              {4 * b, 3 * b}, {4 * b, -b}, {2 * b, -b},    {2 * b, 0}, {0, 0}};
   Path path = Path::from_polyline(route, std::vector<double>(route.size() - 2, kTurnRadius_m), false);
   SpeedPlan plan(path, {kMaxSpeed_m_s, kMaxLateralAccel_m_s2, kMaxLongitudinalAccel_m_s2, kInitialRest_s},
                  {{1, kStopHold_s}, {3, kStopHold_s}, {5, kStopHold_s}});
