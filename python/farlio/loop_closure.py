@@ -69,7 +69,7 @@ AMBIGUITY_YAW_RAD = math.radians(10.0)
 #: a start stalled in a local minimum (a 10 deg turn is 7 m at the far end of a 40 m submap) is no
 #: rival of the found pose: it kept more than this fraction of its start's turn, and fits clearly
 #: worse, with less than AMBIGUITY_MIN_FIT of the found pose's inliers (15-30 % on the racetrack).
-#: Along a featureless straight a start shifted along it keeps its shift but turns back, and counts
+#: Along a featureless straight a start shifted along it keeps its shift but turns back: a rival.
 AMBIGUITY_STALLED_TURN = 0.5
 AMBIGUITY_MIN_FIT = 0.8
 #: overlap: cells of this many export resolutions
