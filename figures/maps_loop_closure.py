@@ -13,7 +13,8 @@ printing
                           of an accepted loop's query keyframe
   verify s, graph s        time spent verifying candidates, and in the pose graph's updates (iSAM2)
   along / across / up m   the global trajectory's error after the APE's alignment, RMS along the
-                          body's axes (x forward, y left, z up of the true pose)
+                          body's axes (x forward, y left, z up of the true pose); then the same of
+                          the odometry's scan poses
 
 With --handover, instead: keyframes HANDOVER_SEPARATION_M apart along the path (every
 HANDOVER_STRIDE-th keyframe against the first one far enough back) are handed to the verification
@@ -39,6 +40,7 @@ from farlio import _core
 from farlio.evaluation import make_options
 from farlio.loop_closure import LOOPS_CSV, MIN_LOOP_TRAVEL_FACTOR, SCANS_BODY_GLOBAL_TUM, LoopClosure
 from farlio.mapping import MapOptions
+from farlio.runner import SCANS_BODY_TUM
 from harness import GeneratedDataset, ape_m, config, fixed_latency, generated_dataset, run, table_row
 from scipy.spatial.transform import Rotation  # xyzw quaternions, as loops.csv
 
@@ -67,6 +69,7 @@ COLUMNS = (
     "verify s",
     "graph s",
     "along / across / up m",
+    "odometry along / across / up m",
 )
 
 
@@ -185,8 +188,11 @@ def main() -> None:
         precision, recall = precision_recall(ds.gen, out / f"run-{seed}" / LOOPS_CSV, cfg.get("loop.submap_length_m"))
         cells = [f"{ape_m(s['accuracy']):.3f}", f"{ape_m(s['accuracy_global']):.3f}"]
         cells += [f"{lc['accepted']} ({lc['in_graph']}) / {lc['candidates']}", f"{precision:.2f}", f"{recall:.2f}"]
-        axes = " / ".join(f"{v:.2f}" for v in error_axes(ds.gen, out / f"run-{seed}" / SCANS_BODY_GLOBAL_TUM))
-        print(table_row(seed, *cells, f"{lc['verify_s']:.1f}", f"{lc['graph_s']:.2f}", axes), flush=True)
+        axes = [
+            " / ".join(f"{v:.2f}" for v in error_axes(ds.gen, out / f"run-{seed}" / name))
+            for name in (SCANS_BODY_GLOBAL_TUM, SCANS_BODY_TUM)
+        ]
+        print(table_row(seed, *cells, f"{lc['verify_s']:.1f}", f"{lc['graph_s']:.2f}", *axes), flush=True)
     print(f"outputs in {out}")
 
 
