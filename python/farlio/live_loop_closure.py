@@ -98,6 +98,12 @@ class LiveLoopClosure:
         """The back end's thread as the OS knows it (for its priority, or a profiler)."""
         return self._thread.native_id
 
+    @property
+    def error(self) -> str | None:
+        """What stopped the back end (it skips the scans after it), or None while it works."""
+        e = self._error
+        return None if e is None else f"{type(e).__name__}: {e}"
+
     def stats(self) -> LoopStats:
         with self._lock:
             s = LoopStats(**vars(self._stats))

@@ -269,3 +269,20 @@ def test_loops_leave_a_walk_that_does_not_drift_as_it_was():
     glob_ape = _core.eval.evaluate(glob, gt, options).ape.translation_m.rmse
     print("handheld: odometry APE", odo_ape, "global APE", glob_ape)
     assert glob_ape <= 1.05 * odo_ape
+
+
+def test_a_failing_back_end_never_stops_the_odometry_side():
+    """A scan the back end cannot use (points that are not (N, 3)) stops the back end, not the
+    caller: submit keeps returning at once, `error` names what happened, and stop raises it."""
+    from farlio.live_loop_closure import LiveLoopClosure
+
+    live = LiveLoopClosure(_core.Config(), _core.SE3(), 0.2)
+    assert live.submit(1, np.eye(4), np.zeros((10, 2), np.float32))
+    assert live.submit(2, np.eye(4), np.zeros((10, 3), np.float32))
+    wait_s = time.monotonic() + 5.0
+    while live.error is None and time.monotonic() < wait_s:
+        time.sleep(0.01)
+    assert live.error is not None and "ValueError" in live.error, live.error
+    assert live.submit(3, np.eye(4), np.zeros((10, 3), np.float32))
+    with pytest.raises(ValueError):
+        live.stop()

@@ -72,6 +72,7 @@ class FarlioNode(Node):
             keep_registered_points=self.params.publish_cloud_registered or self.params.loop_closure,
         )
         self.loops = self._loop_closure(extrinsics[0])
+        self._loop_error_reported = False
         self._gyro_bias = [0.0, 0.0, 0.0]
         # the odometry messages, filled again for every pose: one for the executor thread (fused
         # odometry), one for the result thread (scan odometry, and the odometry when LiDAR-only)
@@ -238,6 +239,9 @@ class FarlioNode(Node):
         out), then publishes the scan's global pose and map_frame -> odom_frame."""
         if self.loops is None or not f.processed or f.scan.failure or f.scan.lost:
             return
+        if self.loops.error and not self._loop_error_reported:
+            self._loop_error_reported = True  # the odometry goes on; the correction stays as it was
+            self.get_logger().error(f"loop closure stopped: {self.loops.error}")
         self.loops.submit(f.scan.stamp_ns, f.scan.pose.matrix(), f.registered_points)
         stamp, p = f.scan.stamp_ns, self.params
         correction = farlio.SE3.from_matrix(self.loops.map_from_odometry())
@@ -334,7 +338,10 @@ class FarlioNode(Node):
         self._results.join()
         self.live.stop()
         if self.loops is not None:
-            self.loops.stop(drain=False)
+            try:
+                self.loops.stop(drain=False)
+            except Exception as e:  # reported, not raised: the node's own shutdown goes on
+                print(f"farlio: loop closure had stopped: {type(e).__name__}: {e}", file=sys.stderr)
         counts = {k: v for k, v in self.live.stats.as_dict().items() if v}
         counts["scans_dropped_busy"] = self.live.odometry.scans_dropped_busy
         # printed: the context (and with it /rosout) is gone after SIGINT
