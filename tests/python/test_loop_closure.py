@@ -64,6 +64,11 @@ def loop_run(profile: str, duration_s: float, **sim):
             odometry.push_back(scan.end_stamp_ns, fr.body_pose)
             loops.add(odo, scan, fr.scan)
     loops.finish()
+    return loops, odometry, *truth(gen)
+
+
+def truth(gen):
+    """(the ground truth's scan poses, its LiDAR pose at a stamp, T_lidar_imu) of a generator."""
     gt = gen.groundtruth_scans()
     stamps = np.array([s for s, _ in gt])
     T_il = gen.T_imu_lidar().matrix()
@@ -71,7 +76,29 @@ def loop_run(profile: str, duration_s: float, **sim):
     def gt_lidar(stamp_ns: int) -> np.ndarray:
         return gt[int(np.searchsorted(stamps, stamp_ns))][1].matrix() @ T_il
 
-    return loops, odometry, gt, gt_lidar, np.linalg.inv(T_il)
+    return gt, gt_lidar, np.linalg.inv(T_il)
+
+
+def assert_accepted_loops_right(loops, gt_lidar) -> list:
+    """Every accepted loop's registered pose within LOOP_TOLERANCE of the truth; returns them."""
+    accepted = [r for r in loops.records if r.accepted]
+    for r in accepted:
+        kq, km = loops.keyframes[r.query], loops.keyframes[r.match]
+        true = np.linalg.inv(gt_lidar(km.stamp_ns)) @ gt_lidar(kq.stamp_ns)
+        m, deg = _off(r.T_match_query, true)
+        assert m < LOOP_TOLERANCE[0] and deg < LOOP_TOLERANCE[1], (r, m, deg)
+    return accepted
+
+
+def odometry_and_global_ape(loops, odometry, gt, T_lidar_imu) -> tuple[float, float, int]:
+    """APE (m) of the odometry's body poses and of the global ones, and how many global poses."""
+    glob = _core.Trajectory()
+    for stamp, T in loops.global_lidar_poses():
+        glob.push_back(stamp, _core.SE3.from_matrix(T @ T_lidar_imu))
+    options = make_options()
+    odo_ape = _core.eval.evaluate(odometry, gt, options).ape.translation_m.rmse
+    glob_ape = _core.eval.evaluate(glob, gt, options).ape.translation_m.rmse
+    return odo_ape, glob_ape, len(glob)
 
 
 @pytest.fixture(scope="module")
@@ -93,13 +120,8 @@ def _off(T_est: np.ndarray, T_true: np.ndarray) -> tuple[float, float]:
 
 def test_the_second_lap_closes_and_every_accepted_loop_is_right(lap):
     loops, _, _, gt_lidar, _ = lap
-    accepted = [r for r in loops.records if r.accepted]
+    accepted = assert_accepted_loops_right(loops, gt_lidar)
     assert len(accepted) >= 3, [(r.query, r.match, r.reason) for r in loops.records]
-    for r in accepted:
-        kq, km = loops.keyframes[r.query], loops.keyframes[r.match]
-        true = np.linalg.inv(gt_lidar(km.stamp_ns)) @ gt_lidar(kq.stamp_ns)
-        m, deg = _off(r.T_match_query, true)
-        assert m < LOOP_TOLERANCE[0] and deg < LOOP_TOLERANCE[1], (r, m, deg)
 
 
 def test_the_revisited_path_is_closed_all_along(lap):
@@ -150,13 +172,8 @@ def test_different_places_are_never_a_loop_at_a_wrong_pose(scene, request):
 
 def test_the_global_trajectory_is_closer_to_the_ground_truth(lap):
     loops, odometry, gt, _, T_lidar_imu = lap
-    glob = _core.Trajectory()
-    for stamp, T in loops.global_lidar_poses():
-        glob.push_back(stamp, _core.SE3.from_matrix(T @ T_lidar_imu))
-    assert len(glob) == len(odometry)
-    options = make_options()
-    odo_ape = _core.eval.evaluate(odometry, gt, options).ape.translation_m.rmse
-    glob_ape = _core.eval.evaluate(glob, gt, options).ape.translation_m.rmse
+    odo_ape, glob_ape, poses = odometry_and_global_ape(loops, odometry, gt, T_lidar_imu)
+    assert poses == len(odometry)
     print("odometry APE", odo_ape, "global APE", glob_ape)
     assert glob_ape < 0.9 * odo_ape
 
@@ -205,27 +222,12 @@ def test_the_live_back_end_closes_the_lap_beside_the_online_odometry():
     loops = live.loops
     stats = live.stats()
     assert stats.scans_dropped == 0 and stats.keyframes == len(loops.keyframes) > 100
-    gt = gen.groundtruth_scans()
-    stamps = np.array([s for s, _ in gt])
-    T_il = gen.T_imu_lidar().matrix()
-
-    def gt_lidar(stamp_ns: int) -> np.ndarray:
-        return gt[int(np.searchsorted(stamps, stamp_ns))][1].matrix() @ T_il
-
-    accepted = [r for r in loops.records if r.accepted]
+    gt, gt_lidar, T_lidar_imu = truth(gen)
+    accepted = assert_accepted_loops_right(loops, gt_lidar)
     assert len(accepted) >= 3 and stats.loops_accepted == len(accepted)
-    for r in accepted:
-        true = np.linalg.inv(gt_lidar(loops.keyframes[r.match].stamp_ns)) @ gt_lidar(loops.keyframes[r.query].stamp_ns)
-        m, deg = _off(r.T_match_query, true)
-        assert m < LOOP_TOLERANCE[0] and deg < LOOP_TOLERANCE[1], (r, m, deg)
     last = loops.keyframes[-1]
     np.testing.assert_allclose(live.map_from_odometry() @ last.T_odom, loops.graph.pose(len(loops.keyframes) - 1))
-    glob = _core.Trajectory()
-    for stamp, T in loops.global_lidar_poses():
-        glob.push_back(stamp, _core.SE3.from_matrix(T @ np.linalg.inv(T_il)))
-    options = make_options()
-    odo_ape = _core.eval.evaluate(odometry, gt, options).ape.translation_m.rmse
-    glob_ape = _core.eval.evaluate(glob, gt, options).ape.translation_m.rmse
+    odo_ape, glob_ape, _ = odometry_and_global_ape(loops, odometry, gt, T_lidar_imu)
     print("live: odometry APE", odo_ape, "global APE", glob_ape, "loops", len(accepted), "of", len(loops.records))
     assert glob_ape < 0.9 * odo_ape
 
@@ -255,18 +257,8 @@ def test_loops_leave_a_walk_that_does_not_drift_as_it_was():
     (global APE within 5 % of the odometry's; 0.013-0.016 m against 0.011 m when such loops were
     added)."""
     loops, odometry, gt, gt_lidar, T_lidar_imu = loop_run("handheld", HANDHELD_RETURN_S)
-    accepted = [r for r in loops.records if r.accepted]
-    assert accepted
-    for r in accepted:
-        true = np.linalg.inv(gt_lidar(loops.keyframes[r.match].stamp_ns)) @ gt_lidar(loops.keyframes[r.query].stamp_ns)
-        m, deg = _off(r.T_match_query, true)
-        assert m < LOOP_TOLERANCE[0] and deg < LOOP_TOLERANCE[1], (r, m, deg)
-    glob = _core.Trajectory()
-    for stamp, T in loops.global_lidar_poses():
-        glob.push_back(stamp, _core.SE3.from_matrix(T @ T_lidar_imu))
-    options = make_options()
-    odo_ape = _core.eval.evaluate(odometry, gt, options).ape.translation_m.rmse
-    glob_ape = _core.eval.evaluate(glob, gt, options).ape.translation_m.rmse
+    assert assert_accepted_loops_right(loops, gt_lidar)
+    odo_ape, glob_ape, _ = odometry_and_global_ape(loops, odometry, gt, T_lidar_imu)
     print("handheld: odometry APE", odo_ape, "global APE", glob_ape)
     assert glob_ape <= 1.05 * odo_ape
 

@@ -35,10 +35,10 @@ from ..datasets.calib import CalibFile
 from . import conversions as conv
 from . import retain_freed_memory
 from .live import FrameReport, LiveOdometry
+from .params import NODE_NAME, NodeParams, config_from, config_param_docs, node_param_docs, node_params_from
 
 if TYPE_CHECKING:
     from farlio.live_loop_closure import LiveLoopClosure
-from .params import NODE_NAME, NodeParams, config_from, config_param_docs, node_param_docs, node_params_from
 
 try:  # not on PyPI: present where ROS 2 is installed from its Debian packages
     from tf2_msgs.msg import TFMessage
