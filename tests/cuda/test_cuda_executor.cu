@@ -99,4 +99,33 @@ TEST(CudaExecutor, TheReadBackRefusesMoreThanItHoldsAndReadsOfWhatWasNotPosted) 
   const gpu::ReadSlot<std::uint8_t> one = rb.post(bytes.data());
   rb.wait();
   EXPECT_THROW((void)rb.value(one, 1), std::logic_error);
+  // one launch brings at most kMaxEntries values back
+  rb.clear();
+  for (int i = 0; i < gpu::ReadBack::kMaxEntries; ++i) (void)rb.post(bytes.data() + i);
+  EXPECT_THROW((void)rb.post(bytes.data()), std::logic_error);
+  rb.wait();
+}
+
+TEST(CudaExecutor, TheReadBackBringsBackOddSizesAtTheirOffsetsAndOnlyWhatWasPostedSinceTheLastClear) {
+  FARLIO_REQUIRE_GPU();
+  gpu::CudaExecutor ex;
+  constexpr std::size_t kN = 37;  // not a multiple of any word
+  std::vector<std::uint8_t> host(kN);
+  for (std::size_t i = 0; i < kN; ++i) host[i] = static_cast<std::uint8_t>(3 * i + 1);
+  gpu::DeviceBuffer<std::uint8_t> bytes(kN, "bytes");
+  bytes.upload(host.data(), kN, ex.stream(), "bytes");
+  gpu::DeviceBuffer<double> value(1, "value");
+  const double pi = 3.141592653589793;
+  value.upload(&pi, 1, ex.stream(), "value");
+  gpu::ReadBack& rb = ex.read_back();
+  rb.clear();
+  (void)rb.post(value.data());  // dropped by the clear below: never brought back
+  rb.clear();
+  const gpu::ReadSlot<std::uint8_t> odd = rb.post(bytes.data() + 1, kN - 1);
+  const gpu::ReadSlot<double> d = rb.post(value.data());
+  rb.wait();
+  for (std::size_t i = 1; i < kN; ++i) EXPECT_EQ(rb.value(odd, i - 1), host[i]) << i;
+  EXPECT_EQ(rb.value(d), pi);
+  rb.wait();  // nothing posted: only the synchronisation
+  EXPECT_EQ(rb.value(d), pi);
 }
