@@ -7,6 +7,7 @@
 
 #include "cuda_test_support.hpp"
 #include "farlio/exec/cpu_executor.hpp"
+#include "farlio/map/key_window.hpp"
 #include "farlio/map/neighbor_search.hpp"
 #include "farlio/map/voxel_map.hpp"
 #include "farlio/pipeline/scan_pipeline.hpp"
@@ -158,8 +159,8 @@ TEST(CudaMap, LoadMapEqualsTheCpu) {
 }
 
 TEST(CudaMap, SortsOnShortKeysOrFallBackToTheFullKeysWithTheSameMap) {
-  // the voxel sort on short keys (points said to lie within a radius) and its fallback when some
-  // do not: the map must equal the CPU's either way
+  // the voxel sort on short keys (points said to lie within a radius), narrow or wide, and its
+  // fallback when some do not: the map must equal the CPU's either way
   FARLIO_REQUIRE_GPU();
   VoxelMapConfig cfg;
   cfg.voxel_size_m = 1.0;
@@ -168,8 +169,14 @@ TEST(CudaMap, SortsOnShortKeysOrFallBackToTheFullKeysWithTheSameMap) {
   exec::CpuExecutor ex(2);
   map::VoxelMap cpu(cfg, ex);
   cpu.insert(pts, origin, map::PointLimit::constant(20));
-  constexpr double kAllWithin_m = 500.0, kFewWithin_m = 3.0;
-  for (const double within_m : {kAllWithin_m, kFewWithin_m}) {
+  // short keys of 30 bits (500 m at 1 m voxels) and of 42 bits (5 km)
+  constexpr double kAllWithin_m = 500.0, kWideWithin_m = 5000.0, kFewWithin_m = 3.0;
+  const auto bits = [&](double within_m) {
+    return map::KeyWindow::around(origin.cast<double>(), within_m, 1.0 / cfg.voxel_size_m).total_bits();
+  };
+  ASSERT_EQ(bits(kAllWithin_m), 30);
+  ASSERT_EQ(bits(kWideWithin_m), 42);
+  for (const double within_m : {kAllWithin_m, kWideWithin_m, kFewWithin_m}) {
     SCOPED_TRACE("within " + std::to_string(within_m) + " m");
     test::DeviceMapRig gpu(cfg, kVoxelCapacity);
     gpu.insert(pts, origin, map::PointLimit::constant(20), within_m);

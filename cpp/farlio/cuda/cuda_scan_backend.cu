@@ -9,6 +9,7 @@
 #include "farlio/cuda/map_scratch.hpp"
 #include "farlio/cuda/stage_timer.hpp"
 #include "farlio/cuda/staged_upload.hpp"
+#include "farlio/cuda/warp_search.cuh"
 #include "farlio/exec/atomics.hpp"
 #include "farlio/map/voxel_update.hpp"
 #include "farlio/preprocess/preprocess_point.hpp"
@@ -59,6 +60,7 @@ class CudaScanBackend final : public pipeline::ScanBackend {
         world_(max_points_, "scan points"),
         source_points_(max_points_, "source points"),
         source_covs_(max_points_, "source points"),
+        matches_(max_points_, "source points"),
         dropped_(1, "non-finite point counts"),
         staging_(max_points_ * (sizeof(Eigen::Vector3f) + sizeof(float)), config.num_threads),
         timer_(executor_.stream()) {
@@ -83,8 +85,9 @@ class CudaScanBackend final : public pipeline::ScanBackend {
     upload_bytes_ = n * (sizeof(Eigen::Vector3f) + (times ? sizeof(float) : 0));
     raw_.require(n, kScanParameter);
     staging_.begin_frame();
-    staging_.upload(scan.points.data(), raw_.data(), n * sizeof(Eigen::Vector3f), executor_.stream());
-    if (times) staging_.upload(scan.time_s.data(), times_.data(), n * sizeof(float), executor_.stream());
+    const StagedUpload::Transfer arrays[] = {{scan.points.data(), raw_.data(), n * sizeof(Eigen::Vector3f)},
+                                             {scan.time_s.data(), times_.data(), times ? n * sizeof(float) : 0}};
+    staging_.upload(arrays, executor_.stream());
     non_finite_points_ = 0;
     frame_size_ = n == 0 ? 0
                          : downsample(n, deskew::DeskewTable::sample(motion, static_cast<float>(scan.duration_s())),
@@ -164,6 +167,9 @@ class CudaScanBackend final : public pipeline::ScanBackend {
   registration::RegistrationResult register_source(const SE3& initial_guess, const registration::Thresholds& th,
                                                    const RegistrationConfig& config, double time_budget_s) override {
     timer_.start(StageTimer::kRegistration);
+    // no point has a correspondence yet (valid = false): each is searched at its first system
+    FARLIO_CUDA_CHECK(
+        cudaMemsetAsync(matches_.data(), 0, source_size_ * sizeof(registration::Correspondence), executor_.stream()));
     const auto result = registration::gauss_newton(
         [&](const SE3& T, std::size_t stride) { return linear_system(T, th, config, stride); }, initial_guess, config,
         time_budget_s);
@@ -171,19 +177,43 @@ class CudaScanBackend final : public pipeline::ScanBackend {
     return result;
   }
 
-  /// One Gauss-Newton system: the shared factor body per source point (every stride-th), reduced
-  /// with CUB.
+  /// One Gauss-Newton system over the source points (every stride-th), in two launches. First the
+  /// points that moved by registration.correspondence_reuse_m since their last search (all of them
+  /// at the first system) are searched again, a warp a point: its lanes look at the 27 voxels around
+  /// it together (warp_nearest_neighbor: map::nearest_neighbor's result, in a few dependent reads
+  /// where one thread walks the voxels one after the other). Then the shared factor body of each
+  /// point at its correspondence, reduced with CUB. The CPU does the same in one pass
+  /// (registration::register_scan).
   registration::LinearSystem linear_system(const SE3& T, const registration::Thresholds& th,
                                            const RegistrationConfig& config, std::size_t stride) {
     const registration::FactorParams fp = registration::factor_params(T, th, config);
+    const auto reuse2 = static_cast<float>(config.correspondence_reuse_m * config.correspondence_reuse_m);
     const map::ConstMapView target = map_.view();
     const Eigen::Vector4f* points = source_points_.data();
     const map::Cov3* covs = source_covs_.data();
+    registration::Correspondence* matches = matches_.data();
+    const std::size_t count = registration::strided_count(source_size_, stride);
+    // a warp a point: the lanes of t / kWarpLanes are one warp's (the grid's stride is whole warps)
+    executor_.for_each(count * kWarpLanes, [=] __device__(std::size_t t) {
+      const std::size_t i = t / kWarpLanes * stride;
+      const auto lane = static_cast<unsigned>(t % kWarpLanes);
+      const Eigen::Vector3f p = fp.R * points[i].head<3>() + fp.t;
+      registration::Correspondence c = matches[i];
+      if (!registration::search_again(c, p, reuse2)) return;  // the same decision in every lane
+      c.nn = warp_nearest_neighbor(target, p, fp.max_correspondence_distance2, lane);
+      c.searched_at = p;
+      c.valid = true;
+      if (lane == 0) matches[i] = c;
+    });
     const registration::FactorSums sums = executor_.reduce(
-        registration::strided_count(source_size_, stride), registration::FactorSums::zero(),
+        count, registration::FactorSums::zero(),
         [=] __device__(std::size_t j) {
           const std::size_t i = j * stride;
-          return registration::factor_sums(target, points[i], covs[i], fp);
+          const Eigen::Vector4f s = points[i];
+          const Eigen::Vector3f p = fp.R * s.head<3>() + fp.t;
+          registration::FactorTerms f;
+          const bool found = registration::gicp_factor_at(target, s, covs[i], p, matches[i].nn, fp, f);
+          return registration::factor_sums_of(found, f);
         },
         registration::AddFactorSums{});
     return registration::to_linear_system(sums);
@@ -231,7 +261,7 @@ class CudaScanBackend final : public pipeline::ScanBackend {
   [[nodiscard]] std::size_t memory_bytes() const override {
     return executor_.memory_bytes() + algorithms_.memory_bytes() + scratch_.memory_bytes() + map_.memory_bytes() +
            frame_map_.memory_bytes() + raw_.bytes() + times_.bytes() + frame_.bytes() + world_.bytes() +
-           source_points_.bytes() + source_covs_.bytes() + dropped_.bytes();
+           source_points_.bytes() + source_covs_.bytes() + matches_.bytes() + dropped_.bytes();
   }
 
   bool device_stage_times(pipeline::FrameTimings& t) override {
@@ -295,8 +325,9 @@ class CudaScanBackend final : public pipeline::ScanBackend {
   DeviceBuffer<Eigen::Vector3f> world_;
   DeviceBuffer<Eigen::Vector4f> source_points_;
   DeviceBuffer<map::Cov3> source_covs_;
-  DeviceBuffer<std::int32_t> dropped_;  // non-finite points of the last scan
-  StagedUpload staging_;                // the scan's way to the device
+  DeviceBuffer<registration::Correspondence> matches_;  // each source point's last search
+  DeviceBuffer<std::int32_t> dropped_;                  // non-finite points of the last scan
+  StagedUpload staging_;                                // the scan's way to the device
   std::size_t frame_size_ = 0;
   std::size_t source_size_ = 0;
   std::size_t map_points_ = 0;  // in the submap after the last update (read back with it)

@@ -6,6 +6,7 @@
 #include "farlio/core/config_fields.hpp"
 #include "farlio/cuda/cuda_executor.cuh"
 #include "farlio/cuda/device_voxel_map.hpp"
+#include "farlio/cuda/warp_search.cuh"
 #include "farlio/map/voxel_update.hpp"
 
 namespace farlio::cuda {
@@ -60,8 +61,6 @@ void add_group_voxels(const map::MapView& v, MapScratch& s, CudaExecutor& ex, st
   });
 }
 
-constexpr unsigned kWarpLanes = 32;
-constexpr unsigned kFullWarp = 0xffffffffu;
 constexpr unsigned kGroupWarps = 4;  // a block's warps: a voxel group each
 constexpr std::size_t kMaxGroupBlocks = 65535;
 

@@ -111,6 +111,12 @@ struct Correspondence {
   bool valid = false;  ///< false before the first search
 };
 
+/// Whether a point now at p is searched again: it has no correspondence yet, or it moved by
+/// sqrt(reuse_distance2) or more since its last search.
+FARLIO_HD inline bool search_again(const Correspondence& c, const Eigen::Vector3f& p, float reuse_distance2) {
+  return !c.valid || !((p - c.searched_at).squaredNorm() < reuse_distance2);
+}
+
 /// gicp_factor, but the nearest neighbour is searched again only when the point moved by
 /// `reuse_distance_m` or more since its last search (the iterations after the first move most
 /// points by millimetres, which changes almost no match); `c` is updated.
@@ -118,7 +124,7 @@ FARLIO_HD inline bool gicp_factor_reusing(const map::ConstMapView& m, const Eige
                                           const FactorParams& fp, float reuse_distance2, Correspondence& c,
                                           FactorTerms& out) {
   const Eigen::Vector3f p = fp.R * s.head<3>() + fp.t;
-  if (!c.valid || !((p - c.searched_at).squaredNorm() < reuse_distance2)) {
+  if (search_again(c, p, reuse_distance2)) {
     c.nn = map::nearest_neighbor(m, p, fp.max_correspondence_distance2);
     c.searched_at = p;
     c.valid = true;
