@@ -85,9 +85,8 @@ class CudaScanBackend final : public pipeline::ScanBackend {
     upload_bytes_ = n * (sizeof(Eigen::Vector3f) + (times ? sizeof(float) : 0));
     raw_.require(n, kScanParameter);
     staging_.begin_frame();
-    const StagedUpload::Transfer arrays[] = {{scan.points.data(), raw_.data(), n * sizeof(Eigen::Vector3f)},
-                                             {scan.time_s.data(), times_.data(), times ? n * sizeof(float) : 0}};
-    staging_.upload(arrays, executor_.stream());
+    staging_.upload(scan.points.data(), raw_.data(), n * sizeof(Eigen::Vector3f), executor_.stream());
+    if (times) staging_.upload(scan.time_s.data(), times_.data(), n * sizeof(float), executor_.stream());
     non_finite_points_ = 0;
     frame_size_ = n == 0 ? 0
                          : downsample(n, deskew::DeskewTable::sample(motion, static_cast<float>(scan.duration_s())),

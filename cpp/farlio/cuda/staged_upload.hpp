@@ -2,14 +2,12 @@
 // Host-to-device copies through page-locked memory. A copy from pageable memory goes through the
 // driver's own staging, one thread at a time: a cold 2 MB scan took ~0.25 ms of a 1 ms GPU frame
 // on an H100 host. Here the host copies the bytes into a page-locked buffer on several threads
-// (at the memory's speed), in pieces, and each piece goes to the copy engine as soon as it is
-// there: the bus's time overlaps the host's. Plain C++ header (the threads are TBB's, in the .cpp).
+// (at the memory's speed) and the copy engine takes them from there at the bus's speed, while
+// the host copies the next array. Plain C++ header (the threads are TBB's, in the .cpp).
 #include <cuda_runtime_api.h>
 
 #include <cstddef>
 #include <memory>
-#include <span>
-#include <vector>
 
 namespace farlio::exec {
 class CpuExecutor;
@@ -33,27 +31,15 @@ class StagedUpload {
   /// Starts a frame: waits until the copy engine has taken the last frame's bytes, then reuses
   /// the buffer from its start.
   void begin_frame();
-  /// One host array to copy to the device.
-  struct Transfer {
-    const void* host;
-    void* device;
-    std::size_t bytes;
-  };
-
   /// Queues the copy of `bytes` host bytes to `device` on `stream`; returns once the host's part
   /// is done (the host memory can then change). Throws CapacityError beyond the capacity.
   void upload(const void* host, void* device, std::size_t bytes, cudaStream_t stream);
-  /// The same for several arrays at once: their pieces are shared out over the host threads together.
-  void upload(std::span<const Transfer> transfers, cudaStream_t stream);
   [[nodiscard]] std::size_t memory_bytes() const { return capacity_; }
 
  private:
   unsigned char* pinned_ = nullptr;
   std::size_t capacity_ = 0;
   std::size_t used_ = 0;
-  int device_ = 0;  // the device of the stream (set on each copying thread)
-  struct Piece;
-  std::vector<Piece> pieces_;    // of the upload in progress (kept: no allocation a frame)
   cudaEvent_t taken_ = nullptr;  // after the last copy out of the buffer
   std::unique_ptr<exec::CpuExecutor> copier_;
 };
