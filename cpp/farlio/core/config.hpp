@@ -124,7 +124,7 @@ inline constexpr double kMaxThreads = 1024.0;
         "stop when |dx| (6-vector, m and rad) falls below this")                                                  \
   FIELD(double, correspondence_reuse_m, 0.02, range::non_negative_up_to(kMaxSiValue),                             \
         "a source point keeps its map match over Gauss-Newton iterations until it has moved this far from where " \
-        "the match was searched (0: a search every iteration, as the paper; the CUDA backend always searches)")   \
+        "the match was searched (0: a search every iteration, as the paper; on both backends)")                   \
   FIELD(int, coarse_stride, 4, range::between(1, kMaxCount),                                                      \
         "after a Gauss-Newton step longer than coarse_step_norm (a far guess: the second scan, a restart), the "  \
         "next iterations use every n-th source point until the steps are short again; the last iterations use "   \
