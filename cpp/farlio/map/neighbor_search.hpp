@@ -91,29 +91,19 @@ struct BlockDistances {
   }
 };
 
-/// Calls f(n) for the voxels n = 1 .. 26 of the block, those of p's octant of the centre voxel
-/// first: the 3 face neighbours across its nearer face on each axis, the 3 edge neighbours
-/// between them, the corner one; then the 19 others in the order of neighbor_code. A point's
-/// nearest neighbours outside its voxel lie mostly in those 7 (the others are at least half a
-/// voxel away), so a search's bound tightens before the far voxels, which it then mostly skips:
-/// when bound2() is within the nearest far side, none of the 19 is visited. A covariance query
-/// of the urban scan compares 40.5 points instead of 45.4 in the order of neighbor_code
-/// (bench_kernels' BM_CovarianceKnn counters).
 /// The codes of the 7 voxels of the block around p's octant of the centre voxel, in the order
 /// for_each_block_neighbor_near_first visits them.
 struct NearOctant {
-  int codes[7];
   int sx, sy, sz;  ///< 0 or 2: the nearer side of the centre voxel on each axis
+  int codes[7];
 
+  FARLIO_HD static constexpr int code(int x, int y, int z) { return x + 3 * y + 9 * z; }
   FARLIO_HD explicit NearOctant(const BlockDistances& box)
       : sx(box.along[0][0] < box.along[0][2] ? 0 : 2),
         sy(box.along[1][0] < box.along[1][2] ? 0 : 2),
-        sz(box.along[2][0] < box.along[2][2] ? 0 : 2) {
-    const auto code = [](int x, int y, int z) { return x + 3 * y + 9 * z; };
-    const int c[7] = {code(sx, 1, 1),  code(1, sy, 1),  code(1, 1, sz),  code(sx, sy, 1),
-                      code(sx, 1, sz), code(1, sy, sz), code(sx, sy, sz)};
-    for (int k = 0; k < 7; ++k) codes[k] = c[k];
-  }
+        sz(box.along[2][0] < box.along[2][2] ? 0 : 2),
+        codes{code(sx, 1, 1),  code(1, sy, 1),  code(1, 1, sz),  code(sx, sy, 1),
+              code(sx, 1, sz), code(1, sy, sz), code(sx, sy, sz)} {}
   /// The rank of block voxel n in the visit order of a search from p: the centre 0, the octant's
   /// voxels 1 to 7, the others after them in the order of their codes.
   [[nodiscard]] FARLIO_HD int visit_rank(int n) const {
@@ -126,14 +116,21 @@ struct NearOctant {
   }
 };
 
+/// Calls f(n) for the voxels n = 1 .. 26 of the block, those of p's octant of the centre voxel
+/// first: the 3 face neighbours across its nearer face on each axis, the 3 edge neighbours
+/// between them, the corner one; then the 19 others in the order of neighbor_code. A point's
+/// nearest neighbours outside its voxel lie mostly in those 7 (the others are at least half a
+/// voxel away), so a search's bound tightens before the far voxels, which it then mostly skips:
+/// when bound2() is within the nearest far side, none of the 19 is visited. A covariance query
+/// of the urban scan compares 40.5 points instead of 45.4 in the order of neighbor_code
+/// (bench_kernels' BM_CovarianceKnn counters).
 template <typename Bound, typename F>
 FARLIO_HD void for_each_block_neighbor_near_first(const BlockDistances& box, const Bound& bound2, const F& f) {
   const auto neighbor = [](int c) { return c < kCentreCode ? c + 1 : c; };  // neighbor_code's inverse
   const NearOctant near(box);
   const int sx = near.sx, sy = near.sy, sz = near.sz;
-  const int(&octant)[7] = near.codes;
   std::uint32_t done = 1u << kCentreCode;
-  for (const int c : octant) {
+  for (const int c : near.codes) {
     done |= 1u << c;
     f(neighbor(c));
   }
