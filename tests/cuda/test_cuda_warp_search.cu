@@ -49,9 +49,8 @@ std::vector<std::int64_t> warp_nearest(test::DeviceMapRig& rig, const std::vecto
 
 /// For every bound: the warp's point is the host search's; some queries find one and, with
 /// `some_missing`, some do not.
-void expect_host_results(const map::VoxelMap& cpu, test::DeviceMapRig& gpu,
-                         const std::vector<Eigen::Vector3f>& queries, const std::vector<float>& bounds2,
-                         bool some_missing) {
+void expect_host_results(const map::VoxelMap& cpu, test::DeviceMapRig& gpu, const std::vector<Eigen::Vector3f>& queries,
+                         const std::vector<float>& bounds2, bool some_missing) {
   for (const float max_d2 : bounds2) {
     const std::vector<std::int64_t> warp = warp_nearest(gpu, queries, max_d2);
     std::size_t found = 0;
