@@ -16,6 +16,14 @@ printing
                           body's axes (x forward, y left, z up of the true pose); then the same of
                           the odometry's scan poses
 
+With --walls, instead: how thick the rebuilt map's surfaces are. The map of every keyframe's
+segment (one centroid per WALL_RESOLUTION_M cell) is rebuilt at three sets of poses: the first
+pass only (the keyframes before the truth first revisits a place), and the whole run at its
+odometry and at its global poses. Each set of poses is aligned to the truth as the APE aligns
+them, and WALL_POINTS of the map's points are measured against the scene's true surfaces: the
+median and 90th percentile of the distance, and the share beyond WALL_FAR_M. A second pass that
+sits beside the first widens the surfaces; one that lies on it does not.
+
 With --handover, instead: keyframes HANDOVER_SEPARATION_M apart along the path (every
 HANDOVER_STRIDE-th keyframe against the first one far enough back) are handed to the verification
 as if they were one place (guess: identity), and each pair's overlap, the distance between the
@@ -23,7 +31,7 @@ ambiguity test's ends and the verdict are printed, with the error of the registe
 the ground truth's relative pose: repeated structure must be refused or found where it truly is.
 
 Usage: python figures/maps_loop_closure.py [--profile racetrack] [--duration 165] [--seeds 1 2 3]
-       [--lidar MODEL] [--lidar-rate HZ] [--set name=value ...] [--out DIR] [--handover]
+       [--lidar MODEL] [--lidar-rate HZ] [--set name=value ...] [--out DIR] [--handover | --walls]
 The racetrack's first lap takes 82.7 s: 165 s is two laps (8.3 km).
 """
 
@@ -39,7 +47,7 @@ import numpy as np
 from farlio import _core
 from farlio.evaluation import make_options
 from farlio.loop_closure import LOOPS_CSV, MIN_LOOP_TRAVEL_FACTOR, SCANS_BODY_GLOBAL_TUM, LoopClosure
-from farlio.mapping import MapOptions
+from farlio.mapping import MapOptions, downsample
 from farlio.runner import SCANS_BODY_TUM
 from harness import GeneratedDataset, ape_m, config, fixed_latency, generated_dataset, run, table_row
 from scipy.spatial.transform import Rotation  # xyzw quaternions, as loops.csv
@@ -47,6 +55,9 @@ from scipy.spatial.transform import Rotation  # xyzw quaternions, as loops.csv
 CORRECT_LOOP_M, CORRECT_LOOP_DEG = 0.5, 1.0
 REVISIT_M = 5.0
 HANDOVER_SEPARATION_M, HANDOVER_STRIDE = (60.0, 200.0), 10
+#: the rebuilt maps' surfaces (--walls): points drawn from each map, its cells, and "far" from a surface
+WALL_POINTS, WALL_RESOLUTION_M, WALL_FAR_M = 100_000, 0.2, 0.2
+WALL_COLUMNS = ("seed", "map", "keyframes", "median m", "90th percentile m", "beyond 0.2 m")
 #: the columns of a handed-over pair
 HANDOVER_COLUMNS = (
     "query",
@@ -79,6 +90,19 @@ def gt_lidar(gen) -> tuple[np.ndarray, list[np.ndarray]]:
     return np.array([s for s, _ in gt]), [p.matrix() @ T_il for _, p in gt]
 
 
+def revisited(poses: list[np.ndarray], submap_length_m: float) -> tuple[np.ndarray, np.ndarray]:
+    """The path length (m) at each true pose, and whether it lies within REVISIT_M of where the
+    truth was at least MIN_LOOP_TRAVEL_FACTOR submap lengths of path earlier."""
+    P = np.array([p[:3, 3] for p in poses])
+    path = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(P, axis=0), axis=1))]
+    min_travel = MIN_LOOP_TRAVEL_FACTOR * submap_length_m
+    revisit = np.zeros(len(P), bool)
+    for i in range(len(P)):
+        earlier = path < path[i] - min_travel
+        revisit[i] = earlier.any() and np.min(np.linalg.norm(P[earlier] - P[i], axis=1)) < REVISIT_M
+    return path, revisit
+
+
 def precision_recall(gen, loops_csv: Path, submap_length_m: float) -> tuple[float, float]:
     stamps, poses = gt_lidar(gen)
 
@@ -96,14 +120,8 @@ def precision_recall(gen, loops_csv: Path, submap_length_m: float) -> tuple[floa
         d = _core.SE3.from_matrix(np.linalg.inv(true) @ m)
         deg = math.degrees(d.angle_rad())
         correct += int(np.linalg.norm(d.translation) < CORRECT_LOOP_M and deg < CORRECT_LOOP_DEG)
-    P = np.array([p[:3, 3] for p in poses])
-    path = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(P, axis=0), axis=1))]
-    min_travel = MIN_LOOP_TRAVEL_FACTOR * submap_length_m
-    revisit = np.zeros(len(P), bool)
-    for i in range(len(P)):
-        earlier = path < path[i] - min_travel
-        revisit[i] = earlier.any() and np.min(np.linalg.norm(P[earlier] - P[i], axis=1)) < REVISIT_M
-    query_path = [path[min(int(np.searchsorted(stamps, int(r["query_stamp_ns"]))), len(P) - 1)] for r in accepted]
+    path, revisit = revisited(poses, submap_length_m)
+    query_path = [path[min(int(np.searchsorted(stamps, int(r["query_stamp_ns"]))), len(path) - 1)] for r in accepted]
     covered = np.array([any(abs(path[i] - q) <= submap_length_m for q in query_path) for i in np.flatnonzero(revisit)])
     precision = correct / len(accepted) if accepted else math.nan
     recall = float(covered.mean()) if len(covered) else math.nan
@@ -127,8 +145,8 @@ def error_axes(gen, tum: Path) -> np.ndarray:
     return np.sqrt((np.array(body) ** 2).mean(axis=0))
 
 
-def handover(ds: GeneratedDataset, cfg) -> None:
-    """Different places handed over as one (see the module doc)."""
+def closed_loops(ds: GeneratedDataset, cfg) -> LoopClosure:
+    """The odometry over the dataset (fixed latency) with the loop closure beside it, in process."""
     odo = _core.Odometry(cfg, ds.T_imu_lidar(), ds.gravity_m_s2(), ds.imu(), fixed_latency())
     loops = LoopClosure(cfg, ds.T_imu_lidar())
     for i in range(len(ds)):
@@ -137,6 +155,52 @@ def handover(ds: GeneratedDataset, cfg) -> None:
         if fr.processed and not fr.scan.failure:
             loops.add(odo, scan, fr.scan)
     loops.finish()
+    return loops
+
+
+def surface_distances(gen, keyframes: list, poses: list[np.ndarray], resolution_m: float) -> np.ndarray:
+    """|distance| (m) to the scene's nearest true surface of WALL_POINTS points (a fixed draw) of
+    the map of these keyframes' segments at these LiDAR poses, one centroid per cell, after the
+    APE's alignment of the poses to the truth's (the evaluation's own, without scale)."""
+    truth_stamps, truth = gt_lidar(gen)
+    est, ref = _core.Trajectory(), _core.Trajectory()
+    for kf, pose in zip(keyframes, poses):
+        true_pose = truth[min(int(np.searchsorted(truth_stamps, kf.stamp_ns)), len(truth) - 1)]
+        est.push_back(kf.stamp_ns, _core.SE3.from_matrix(pose))
+        ref.push_back(kf.stamp_ns, _core.SE3.from_matrix(true_pose))
+    align = _core.eval.evaluate(est, ref, make_options()).ape.alignment.transform.matrix()
+    parts = [(kf.points @ pose[:3, :3].T + pose[:3, 3]) for kf, pose in zip(keyframes, poses) if kf.points is not None]
+    points = downsample(np.concatenate(parts).astype(np.float64), resolution_m)
+    rng = np.random.default_rng(0)
+    points = points[rng.choice(len(points), min(WALL_POINTS, len(points)), replace=False)]
+    world = points @ align[:3, :3].T + align[:3, 3]
+    return np.abs(np.asarray(gen.surface_distance_m(world)))
+
+
+def walls(ds: GeneratedDataset, cfg, seed: int) -> None:
+    """How thick the rebuilt map's surfaces are (see the module doc)."""
+    loops = closed_loops(ds, cfg)
+    kfs = loops.keyframes
+    stamps, poses = gt_lidar(ds.gen)
+    _, revisit = revisited(poses, cfg.get("loop.submap_length_m"))
+    first_revisit_ns = stamps[np.argmax(revisit)] if revisit.any() else stamps[-1]
+    first_pass = [k for k, kf in enumerate(kfs) if kf.stamp_ns <= first_revisit_ns]
+    odometry = [kf.T_odom for kf in kfs]
+    global_ = [loops.graph.pose(k) for k in range(len(kfs))]
+    maps = {
+        "one pass, odometry": ([kfs[k] for k in first_pass], [odometry[k] for k in first_pass]),
+        "all, odometry": (kfs, odometry),
+        "all, global": (kfs, global_),
+    }
+    for name, (keyframes, kf_poses) in maps.items():
+        d = surface_distances(ds.gen, keyframes, kf_poses, WALL_RESOLUTION_M)
+        cells = [f"{np.median(d):.3f}", f"{np.percentile(d, 90):.3f}", f"{np.mean(d > WALL_FAR_M):.3f}"]
+        print(table_row(seed, name, len(keyframes), *cells), flush=True)
+
+
+def handover(ds: GeneratedDataset, cfg) -> None:
+    """Different places handed over as one (see the module doc)."""
+    loops = closed_loops(ds, cfg)
     stamps, poses = gt_lidar(ds.gen)
 
     def at(stamp: int) -> np.ndarray:
@@ -168,9 +232,18 @@ def main() -> None:
     ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE")
     ap.add_argument("--out", type=Path, default=None)
     ap.add_argument("--handover", action="store_true", help="different places handed over as one (module doc)")
+    ap.add_argument("--walls", action="store_true", help="how thick the rebuilt maps' surfaces are (module doc)")
     args = ap.parse_args()
     out = args.out or Path(tempfile.mkdtemp(prefix="measure_loops_"))
     cfg = config(args.set)
+    if args.walls:
+        print(table_row(*WALL_COLUMNS))
+        for seed in args.seeds:
+            ds = generated_dataset(
+                args.profile, seed, args.duration, out, lidar=args.lidar, lidar_rate_hz=args.lidar_rate
+            )
+            walls(ds, cfg, seed)
+        return
     if args.handover:
         for seed in args.seeds:
             handover(
