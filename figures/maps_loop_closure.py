@@ -158,18 +158,22 @@ def closed_loops(ds: GeneratedDataset, cfg) -> LoopClosure:
     return loops
 
 
-def surface_distances(gen, keyframes: list, poses: list[np.ndarray], resolution_m: float) -> np.ndarray:
+def surface_distances(
+    gen, truth: tuple[np.ndarray, list[np.ndarray]], loops: LoopClosure, poses: list[np.ndarray], resolution_m: float
+) -> np.ndarray:
     """|distance| (m) to the scene's nearest true surface of WALL_POINTS points (a fixed draw) of
-    the map of these keyframes' segments at these LiDAR poses, one centroid per cell, after the
-    APE's alignment of the poses to the truth's (the evaluation's own, without scale)."""
-    truth_stamps, truth = gt_lidar(gen)
+    the map of the first len(poses) keyframes' segments at these LiDAR poses, one centroid per cell,
+    after the APE's alignment of the poses to the truth's (gt_lidar; the evaluation's own, without
+    scale)."""
+    truth_stamps, truth_poses = truth
     est, ref = _core.Trajectory(), _core.Trajectory()
-    for kf, pose in zip(keyframes, poses):
-        true_pose = truth[min(int(np.searchsorted(truth_stamps, kf.stamp_ns)), len(truth) - 1)]
+    for kf, pose in zip(loops.keyframes, poses):
+        true_pose = truth_poses[min(int(np.searchsorted(truth_stamps, kf.stamp_ns)), len(truth_poses) - 1)]
         est.push_back(kf.stamp_ns, _core.SE3.from_matrix(pose))
         ref.push_back(kf.stamp_ns, _core.SE3.from_matrix(true_pose))
     align = _core.eval.evaluate(est, ref, make_options()).ape.alignment.transform.matrix()
-    parts = [(kf.points @ pose[:3, :3].T + pose[:3, 3]) for kf, pose in zip(keyframes, poses) if kf.points is not None]
+    # in double: the map's points as measured, not as LoopClosure stores them (float32)
+    parts = [kf.points @ T[:3, :3].T + T[:3, 3] for kf, T in zip(loops.keyframes, poses) if kf.points is not None]
     points = downsample(np.concatenate(parts).astype(np.float64), resolution_m)
     rng = np.random.default_rng(0)
     points = points[rng.choice(len(points), min(WALL_POINTS, len(points)), replace=False)]
@@ -181,21 +185,21 @@ def walls(ds: GeneratedDataset, cfg, seed: int) -> None:
     """How thick the rebuilt map's surfaces are (see the module doc)."""
     loops = closed_loops(ds, cfg)
     kfs = loops.keyframes
-    stamps, poses = gt_lidar(ds.gen)
+    truth = gt_lidar(ds.gen)
+    stamps, poses = truth
     _, revisit = revisited(poses, cfg.get("loop.submap_length_m"))
     first_revisit_ns = stamps[np.argmax(revisit)] if revisit.any() else stamps[-1]
-    first_pass = [k for k, kf in enumerate(kfs) if kf.stamp_ns <= first_revisit_ns]
+    first_pass = sum(1 for kf in kfs if kf.stamp_ns <= first_revisit_ns)  # the keyframes come in time order
     odometry = [kf.T_odom for kf in kfs]
-    global_ = [loops.graph.pose(k) for k in range(len(kfs))]
     maps = {
-        "one pass, odometry": ([kfs[k] for k in first_pass], [odometry[k] for k in first_pass]),
-        "all, odometry": (kfs, odometry),
-        "all, global": (kfs, global_),
+        "one pass, odometry": odometry[:first_pass],
+        "all, odometry": odometry,
+        "all, global": [loops.graph.pose(k) for k in range(len(kfs))],
     }
-    for name, (keyframes, kf_poses) in maps.items():
-        d = surface_distances(ds.gen, keyframes, kf_poses, WALL_RESOLUTION_M)
+    for name, kf_poses in maps.items():
+        d = surface_distances(ds.gen, truth, loops, kf_poses, WALL_RESOLUTION_M)
         cells = [f"{np.median(d):.3f}", f"{np.percentile(d, 90):.3f}", f"{np.mean(d > WALL_FAR_M):.3f}"]
-        print(table_row(seed, name, len(keyframes), *cells), flush=True)
+        print(table_row(seed, name, len(kf_poses), *cells), flush=True)
 
 
 def handover(ds: GeneratedDataset, cfg) -> None:
