@@ -130,6 +130,59 @@ TEST(Degeneracy, TheStepHoldsADegenerateDirectionAndSolvesTheOthers) {
   }
 }
 
+// What the fusion is given along a held direction: the scan's own step there. In the corridor with
+// a weak along-track term and a pose error along the track, the unconstrained step moves the pose
+// back by that error along the axis and by nothing else; through an extrinsic it is the body's
+// displacement of the full step (brute force: the poses themselves), projected on the axis.
+TEST(Degeneracy, TheDegenerateTranslationStepIsTheScansOwnStepAlongTheAxis) {
+  RegistrationConfig config;
+  const double scale = 0.05;
+  const Mat6d H = corridor_information(1e-1);
+  const registration::Degeneracy d =
+      registration::analyze_degeneracy(registration::covariance_from_information(H / scale), kCorridorFactors, config);
+  ASSERT_EQ(d.degenerate_translations, 1);
+  Vec6d error;
+  error << 0.3, 0.1, -0.05, 0.01, -0.02, 0.005;
+  registration::LinearSystem system;
+  system.H = H;
+  system.b = H * error;
+  const Eigen::Vector3d step = registration::degenerate_translation_step(system, 0.0, SE3(), d);
+  EXPECT_NEAR(step.x(), -error(0), 1e-9);
+  EXPECT_NEAR(step.tail<2>().norm(), 0.0, 1e-9);
+
+  std::mt19937 rng(5);
+  for (int c = 0; c < 10; ++c) {
+    const SE3 T_world_sensor = random_pose(rng), T_body_sensor = random_pose(rng);
+    system.b = H * (1e-4 * error);  // a small step: the first-order body displacement is exact to 1e-8
+    const Vec6d dx = (system.H + config.damping * Mat6d::Identity()).ldlt().solve(-system.b);
+    const SE3 body = T_world_sensor * T_body_sensor.inverse();
+    const SE3 moved = T_world_sensor * SE3::exp(dx) * T_body_sensor.inverse();
+    const Eigen::Vector3d displacement = body.rotation().transpose() * (moved.translation() - body.translation());
+    // the axes of a body-frame analysis: the corridor's axis moved into the body
+    registration::Degeneracy body_d = d;
+    body_d.translation_axes = T_body_sensor.rotation() * d.translation_axes;
+    const Eigen::Vector3d axis = body_d.translation_axes.col(0);
+    const Eigen::Vector3d got =
+        registration::degenerate_translation_step(system, config.damping, T_body_sensor, body_d);
+    EXPECT_LT((got - axis * axis.dot(displacement)).norm(), 1e-8) << c;
+  }
+  registration::Degeneracy none = d;
+  none.degenerate_translations = 0;
+  EXPECT_EQ(registration::degenerate_translation_step(system, 0.0, SE3(), none), Eigen::Vector3d::Zero());
+}
+
+TEST(Degeneracy, ReleasingRotationsKeepsTheTranslations) {
+  RegistrationConfig config;
+  const Mat6d C = registration::covariance_from_information(corridor_information(1e-3) / 0.05);
+  registration::Degeneracy d = registration::analyze_degeneracy(C, kCorridorFactors, config);
+  d.degenerate_rotations = 1;  // and one rotation axis
+  const Mat6d released = registration::release_degenerate_rotations(C, d);
+  EXPECT_LT((released.topLeftCorner<3, 3>() - C.topLeftCorner<3, 3>()).norm(), 1e-12);
+  const Eigen::Vector3d axis = d.rotation_axes.col(0);
+  EXPECT_GT(axis.dot(released.bottomRightCorner<3, 3>() * axis),
+            0.99 * registration::kUnconstrainedStd * registration::kUnconstrainedStd);
+}
+
 // The per-point std (degenerate_translation_point_std_m): a room seen by few points is loose in
 // every direction without being degenerate in any (its std per point is 1.04 m); a corridor's axis
 // stays degenerate however many points see it. Without the per-point limit the std alone flags the

@@ -1,7 +1,8 @@
 """Degeneracy: in the tunnel profile's 600 m bare section the scans do not fix the
-motion along the track. The LIO holds those directions at the IMU prediction (registration) and
-takes them from the IMU (fusion): its KITTI-style RPE stays under 1 % while LiDAR-only slides.
-docs/fusion.md "Degeneracy" has the table (`figures/fusion_tunnel.py`)."""
+motion along the track. The registration holds that direction at the IMU prediction and the fusion
+gets only the scan's own step along it, at its covariance: the LIO's KITTI-style RPE stays under
+2 % (1.55 % measured) while LiDAR-only slides (12.6 %). docs/fusion.md "Degeneracy" has the table
+(`figures/fusion_tunnel.py`)."""
 
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ from farlio.runner import replay_options, run_dataset
 from farlio.simulation import generate
 
 SEED = 2
-LIO_RPE_MAX_PCT = 1.0
+LIO_RPE_MAX_PCT = 2.0
 # LiDAR-only slides by tens of metres (measured RPE 16-21 %): at least this many times the LIO's
 SLIDE_FACTOR = 5.0
 # the bare section is 21.6 s of the 45 s at 10 Hz: most of its scans must be flagged

@@ -317,17 +317,35 @@ ScanPrior FusionDriver::prior(const Scan& scan, const registration::Vec6d& lidar
   return prior;
 }
 
+bool FusionDriver::held_at_prior(const OdometryFrame& frame) const {
+  return registration_config_.hold_degenerate_directions && frame.guess_from_fusion && frame.degeneracy &&
+         frame.degeneracy->degenerate();
+}
+
 std::optional<Mat6d> FusionDriver::registration_covariance(OdometryFrame& frame) const {
   if (!frame.scan.registered || frame.scan.registration.system.inliers <= 0) return std::nullopt;
   Mat6d covariance = registration::covariance_from_information(registration::body_information(
       frame.scan.registration.system.H, T_imu_lidar_, registration_config_.covariance_scale));
   frame.degeneracy = registration::analyze_degeneracy(
       covariance, static_cast<double>(frame.scan.registration.system.inliers), registration_config_);
-  // the registration held these at the fusion's prior: the scan says nothing there
-  if (registration_config_.hold_degenerate_directions && frame.guess_from_fusion) {
-    covariance = registration::release_degenerate_directions(covariance, *frame.degeneracy);
+  if (held_at_prior(frame)) {
+    // the registration held its degenerate directions at the fusion's prior. A degenerate rotation
+    // axis says nothing; along a degenerate translation the fusion gets the scan's own step
+    // (measured_body_pose) at its covariance
+    covariance = registration::release_degenerate_rotations(covariance, *frame.degeneracy);
   }
   return covariance;
+}
+
+SE3 FusionDriver::measured_body_pose(const OdometryFrame& frame) const {
+  if (!held_at_prior(frame) || frame.degeneracy->degenerate_translations == 0) return frame.body_pose;
+  // the registration's step along a degenerate translation, the pose held there returned plus
+  // what the scan's weak constraint adds: on a sparse LiDAR at speed (16-32 beams on a
+  // racetrack) it is what keeps the IMU's drift along the track in check
+  Vec6d xi = Vec6d::Zero();
+  xi.head<3>() = registration::degenerate_translation_step(frame.scan.registration.system, registration_config_.damping,
+                                                           T_imu_lidar_, *frame.degeneracy);
+  return frame.body_pose * SE3::exp(xi);
 }
 
 void FusionDriver::compare_gyro_unit(std::int64_t stamp_ns, const OdometryFrame& frame) {
@@ -396,6 +414,7 @@ void FusionDriver::link(const Scan& scan, OdometryFrame& frame) {
   if (fusion_ && (frame.scan.map_restarted || frame.scan.map_started_here)) fusion_->restart_window();
   const std::optional<Mat6d> covariance = registration_covariance(frame);
   const std::int64_t stamp_ns = scan.end_stamp_ns;
+  const SE3 measured = measured_body_pose(frame);
   if (frame.drop_reason.empty() && fusion_ && !has_imu()) {
     frame.drop_reason = "not fused: no IMU sample yet (LiDAR-only until the first one arrives)";
     if (!warned_no_imu_) {
@@ -423,16 +442,16 @@ void FusionDriver::link(const Scan& scan, OdometryFrame& frame) {
     const bool has_velocity = last_body_.has_value() && stamp_ns > last_body_->stamp_ns;
     if (has_velocity) {  // eq. (6) on the body poses
       const double dt_s = ns_to_seconds(stamp_ns - last_body_->stamp_ns);
-      velocity = velocity_from_poses(last_body_->pose, frame.body_pose, dt_s);
+      velocity = velocity_from_poses(last_body_->pose, measured, dt_s);
       if (covariance && last_covariance_) {
         velocity_covariance =
             fusion::velocity_measurement_covariance(*covariance, *last_covariance_, dt_s, fusion_->config());
       }
     }
-    fuse_when_covered({stamp_ns, frame.body_pose, velocity, has_velocity, covariance, velocity_covariance});
+    fuse_when_covered({stamp_ns, measured, velocity, has_velocity, covariance, velocity_covariance});
     frame.fused = true;
   }
-  last_body_ = StampedPose{scan.end_stamp_ns, frame.body_pose};
+  last_body_ = StampedPose{scan.end_stamp_ns, measured};
   last_covariance_ = covariance;
 }
 

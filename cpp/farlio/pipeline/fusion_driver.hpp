@@ -155,9 +155,14 @@ class FusionDriver {
   void jump_clock(const ImuSample& sample);
   /// After the gyro unit was decided: scales and restarts, or ends the fusion.
   void apply_gyro_unit();
-  /// The registration's pose covariance in the body frame (its degenerate directions released when
-  /// the registration held them); sets frame.degeneracy. nullopt without a registered scan.
+  /// Whether the registration held the frame's degenerate directions at the fusion's prior.
+  [[nodiscard]] bool held_at_prior(const OdometryFrame& frame) const;
+  /// The registration's pose covariance in the body frame (its degenerate rotation axes released
+  /// when the registration held them); sets frame.degeneracy. nullopt without a registered scan.
   [[nodiscard]] std::optional<Mat6d> registration_covariance(OdometryFrame& frame) const;
+  /// The body pose fused for the frame: the registered one, moved along degenerate translations the
+  /// registration held by the step the scan gives there (registration::degenerate_translation_step).
+  [[nodiscard]] SE3 measured_body_pose(const OdometryFrame& frame) const;
   /// While the gyro's unit is undecided: compares the gyro's rotation with the LiDAR's over the
   /// last scan interval (scans with a degenerate direction left out) and applies a decision.
   void compare_gyro_unit(std::int64_t stamp_ns, const OdometryFrame& frame);

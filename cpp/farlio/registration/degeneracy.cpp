@@ -89,4 +89,25 @@ Mat6d release_degenerate_directions(const Mat6d& covariance, const Degeneracy& d
   return covariance + kUnconstrainedStd * kUnconstrainedStd * C * C.transpose();
 }
 
+Mat6d release_degenerate_rotations(const Mat6d& covariance, const Degeneracy& d) {
+  Degeneracy rotations = d;
+  rotations.degenerate_translations = 0;
+  return release_degenerate_directions(covariance, rotations);
+}
+
+Eigen::Vector3d degenerate_translation_step(const LinearSystem& system, double damping, const SE3& T_body_sensor,
+                                            const Degeneracy& d) {
+  Eigen::Vector3d step = Eigen::Vector3d::Zero();
+  if (d.degenerate_translations == 0) return step;
+  const Vec6d dx_sensor = (system.H + damping * Mat6d::Identity()).ldlt().solve(-system.b);
+  if (!dx_sensor.allFinite()) return step;
+  // a right perturbation xi of the sensor pose is adjoint(T_body_sensor) xi of the body pose
+  const Eigen::Vector3d dt_body = (adjoint(T_body_sensor) * dx_sensor).head<3>();
+  for (int i = 0; i < d.degenerate_translations; ++i) {
+    const Eigen::Vector3d axis = d.translation_axes.col(i);
+    step += axis * axis.dot(dt_body);
+  }
+  return step;
+}
+
 }  // namespace farlio::registration

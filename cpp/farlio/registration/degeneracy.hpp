@@ -52,4 +52,15 @@ Vec6d step_without_degenerate_directions(const Mat6d& H, const Vec6d& b, const D
 /// along each, so that a filter takes the state there from its own prediction.
 Mat6d release_degenerate_directions(const Mat6d& covariance, const Degeneracy& d);
 
+/// The same for the degenerate rotation axes only.
+Mat6d release_degenerate_rotations(const Mat6d& covariance, const Degeneracy& d);
+
+/// What the scan says along its degenerate translation directions: the Gauss-Newton step of the
+/// unconstrained system (H + damping I) dx = -b (sensor frame, right perturbation, the system a
+/// registration held those directions in) moved into the body frame through T_body_sensor and
+/// projected on the degenerate translation axes of `d` (body frame). Zero without degenerate
+/// translations. The body pose the scan measures is body_pose * exp([step; 0]).
+Eigen::Vector3d degenerate_translation_step(const LinearSystem& system, double damping, const SE3& T_body_sensor,
+                                            const Degeneracy& d);
+
 }  // namespace farlio::registration
