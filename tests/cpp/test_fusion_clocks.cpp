@@ -402,6 +402,27 @@ TEST(ReplayClocks, AGyroInDegreesPerSecondIsScaled) {
   EXPECT_LT(deg_m, 2.0 * normal_m + 0.02) << "rad/s: " << normal_m << " m";
 }
 
+// The kernel scale with the fusion's guess: capped at registration.fused_kernel_scale_m until the
+// gyro's unit is decided against the LiDAR, at confirmed_kernel_scale_m after, never back.
+TEST(ReplayClocks, TheFusionsGuessGetsTheTightKernelOnceTheGyroIsConfirmed) {
+  const ReplayRun run = replay(handheld(), handheld().imu);
+  const RegistrationConfig& reg = deterministic_config().registration;
+  int confirmed = 0;
+  bool seen_confirmed = false;
+  for (const auto& f : run.frames) {
+    if (!f.guess_from_fusion || !f.scan.registered) continue;
+    const double loose = std::min(f.scan.sigma_m / 3.0, reg.fused_kernel_scale_m);
+    const double tight = std::min(f.scan.sigma_m / 3.0, reg.confirmed_kernel_scale_m);
+    ASSERT_TRUE(f.scan.kernel_scale_m == loose || f.scan.kernel_scale_m == tight) << f.scan.kernel_scale_m;
+    if (tight < loose && f.scan.kernel_scale_m == tight) {
+      ++confirmed;
+      seen_confirmed = true;
+    }
+    if (seen_confirmed) EXPECT_EQ(f.scan.kernel_scale_m, tight);
+  }
+  EXPECT_GT(confirmed, 10);
+}
+
 TEST(ReplayClocks, AnUndecidedGyroUnitIsAWarning) {
   // the generator's urban drive goes straight for its first 12 s without any rotation: a gyro in
   // deg/s cannot be told from one in rad/s, and the run says so (before: nothing was said)
@@ -481,6 +502,13 @@ TEST(ReplayClocks, AStuckGyroEndsTheFusion) {
   const ReplayRun run = replay(rec, stuck);
   EXPECT_TRUE(contains(run.warnings, "the gyro is stuck")) << joined(run.warnings);
   EXPECT_FALSE(run.inertial_at_end);
+  // a guess from a gyro not confirmed against the LiDAR never gets the tight kernel: the scans
+  // must still be able to show the turn the gyro misses
+  const RegistrationConfig& reg = deterministic_config().registration;
+  for (const auto& f : run.frames) {
+    if (f.guess_from_fusion && f.scan.registered)
+      EXPECT_DOUBLE_EQ(f.scan.kernel_scale_m, std::min(f.scan.sigma_m / 3.0, reg.fused_kernel_scale_m));
+  }
   for (const auto& f : run.frames) EXPECT_TRUE(f.body_pose.translation().allFinite());
 }
 

@@ -181,7 +181,9 @@ TEST(ScanPipeline, ADegenerateScanFailsKeepsThePredictionAndChangesNothing) {
 }
 
 // The Cauchy kernel scale: sigma / 3 (KISS-ICP) with the constant-velocity guess, at most
-// registration.fused_kernel_scale_m with a guess from another sensor (the fusion's), never wider.
+// registration.fused_kernel_scale_m with a guess from another sensor (the fusion's), at most
+// confirmed_kernel_scale_m once that guess is confirmed (frames 8-12), never wider; a LiDAR-only
+// guess keeps sigma / 3 even when called confirmed.
 TEST(ScanPipeline, AGuessFromTheFusionCapsTheKernelScale) {
   const double period = 0.1;
   for (const double cap_m : {0.2, 10.0}) {
@@ -189,18 +191,23 @@ TEST(ScanPipeline, AGuessFromTheFusionCapsTheKernelScale) {
     cfg.num_threads = 2;
     cfg.registration.time_budget_factor = 1e6;
     cfg.registration.fused_kernel_scale_m = cap_m;
+    cfg.registration.confirmed_kernel_scale_m = 0.5 * cap_m;
     pipeline::ScanPipeline p(cfg, truth_at(period));
     for (int k = 0; k < 3; ++k) {
       const auto r = p.process(make_scan(k, period));
       if (k > 0) EXPECT_DOUBLE_EQ(r.kernel_scale_m, r.sigma_m / 3.0) << "constant velocity, frame " << k;
     }
-    for (int k = 3; k < 8; ++k) {
+    for (int k = 3; k < 13; ++k) {
+      const bool confirmed = k >= 8;
       const SE3 guess = truth_at((k + 1) * period);
-      const auto r = p.process(make_scan(k, period), guess);
+      const auto r = p.process(make_scan(k, period), guess, std::nullopt, true, confirmed);
       ASSERT_TRUE(r.failure.empty()) << r.failure;
-      EXPECT_DOUBLE_EQ(r.kernel_scale_m, std::min(r.sigma_m / 3.0, cap_m)) << "fusion's guess, frame " << k;
+      EXPECT_DOUBLE_EQ(r.kernel_scale_m, std::min(r.sigma_m / 3.0, confirmed ? 0.5 * cap_m : cap_m))
+          << "fusion's guess, frame " << k;
       EXPECT_LT(translation_error_m(r.pose, guess), 0.03);
     }
+    const auto r = p.process(make_scan(13, period), truth_at(14 * period), std::nullopt, false, true);
+    EXPECT_DOUBLE_EQ(r.kernel_scale_m, r.sigma_m / 3.0) << "a LiDAR-only guess";
   }
 }
 

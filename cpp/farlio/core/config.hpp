@@ -142,6 +142,10 @@ inline constexpr double kMaxThreads = 1024.0;
         "KISS-ICP's sigma / 3 measures a constant-velocity guess; the IMU's guess deviates less than "            \
         "threshold.min_motion_m, so sigma keeps its initial value and sigma / 3 lets wrong matches pull "         \
         "(docs/fusion.md); LiDAR-only keeps sigma / 3, which its standing start needs")                           \
+  FIELD(double, confirmed_kernel_scale_m, 0.15, range::positive_up_to(kMaxSiValue),                               \
+        "LIO: the kernel scale cap once the fusion's guess is confirmed (the gyro's unit decided against the "    \
+        "LiDAR's rotations); tighter than fused_kernel_scale_m, which a guess not yet confirmed (a stuck gyro) "  \
+        "needs so that the scans can still show the turn the gyro misses")                                        \
   FIELD(double, damping, 1e-9, range::non_negative_up_to(kMaxRatio), "lambda added to the diagonal of H")         \
   FIELD(double, covariance_scale, 0.05, range::positive_up_to(kMaxRatio),                                         \
         "pose covariance = covariance_scale * H^-1 (H in the factors' normalised units; docs/fusion.md measures " \

@@ -291,6 +291,7 @@ ScanPrior FusionDriver::prior(const Scan& scan, const registration::Vec6d& lidar
       prior.guess = *body * T_imu_lidar_;
       prior.motion = motion_from_fusion(*fusion_, scan, *prior.guess, T_imu_lidar_);
       prior.fused = true;
+      prior.confirmed = gyro_unit_.decided() && gyro_unit_.unit() != fusion::GyroUnit::kStuck;
     }
     return prior;
   }

@@ -74,6 +74,7 @@ struct ScanPrior {
   std::optional<SE3> guess;                  ///< LiDAR pose at the scan end
   std::optional<deskew::ScanMotion> motion;  ///< LiDAR motion during the scan
   bool fused = false;                        ///< from the filter
+  bool confirmed = false;                    ///< fused, with the gyro's unit decided against the LiDAR
 };
 
 /// A LiDAR result for the fusion (FusionDriver::link): the body pose at the scan end, its

@@ -143,7 +143,7 @@ OdometryFrame Odometry::process(const Scan& scan) {
 
   const ScanPrior prior = driver_.prior(scan, pipeline_.last_twist());
   out.guess_from_fusion = prior.guess.has_value() && prior.fused;
-  out.scan = pipeline_.process(scan, prior.guess, prior.motion, prior.fused);
+  out.scan = pipeline_.process(scan, prior.guess, prior.motion, prior.fused, prior.confirmed);
   out.processed = true;
   out.body_pose = out.scan.pose * T_lidar_imu_;
   out.available_ns = out.started_ns + seconds_to_ns(latency_s(out.scan));

@@ -130,7 +130,7 @@ OdometryFrame OnlineOdometry::process(const Scan& scan) {
     out.started_ns = fused_clock() ? driver_.clock_ns() : scan.end_stamp_ns;
   }
   out.guess_from_fusion = prior.guess.has_value() && prior.fused;
-  out.scan = pipeline_.process(scan, prior.guess, prior.motion, prior.fused);
+  out.scan = pipeline_.process(scan, prior.guess, prior.motion, prior.fused, prior.confirmed);
   out.processed = true;
   out.body_pose = out.scan.pose * T_lidar_imu_;
   if (keep_registered_points_) {

@@ -71,7 +71,8 @@ registration::Vec6d ScanPipeline::last_twist() const {
   return twist_between(prev_pose_, last_pose_, prev_stamp_ns_, last_stamp_ns_);
 }
 
-std::string ScanPipeline::register_frame(FrameResult& out, bool fused_guess, double time_budget_s) {
+std::string ScanPipeline::register_frame(FrameResult& out, bool fused_guess, bool guess_confirmed,
+                                         double time_budget_s) {
   // the spacing as the backends' maps hold it (float)
   const auto spacing_m = static_cast<float>(map::point_spacing_m(config_.map));
   const double p2p =
@@ -82,10 +83,14 @@ std::string ScanPipeline::register_frame(FrameResult& out, bool fused_guess, dou
   RegistrationConfig reg = config_.registration;
   reg.hold_degenerate_directions = reg.hold_degenerate_directions && fused_guess;
   // The kernel scale sigma / 3 follows the constant-velocity model's deviations; the fusion's
-  // guess deviates far less than sigma says (registration.fused_kernel_scale_m).
+  // guess deviates far less than sigma says (registration.fused_kernel_scale_m), and once it is
+  // confirmed (the gyro's unit decided against the LiDAR) less still (confirmed_kernel_scale_m).
   registration::Thresholds thresholds = registration::Thresholds::from_sigma(out.sigma_m, p2p);
-  if (fused_guess)
-    thresholds.kernel_scale_m = std::min(thresholds.kernel_scale_m, config_.registration.fused_kernel_scale_m);
+  if (fused_guess) {
+    const double cap_m =
+        guess_confirmed ? config_.registration.confirmed_kernel_scale_m : config_.registration.fused_kernel_scale_m;
+    thresholds.kernel_scale_m = std::min(thresholds.kernel_scale_m, cap_m);
+  }
   out.kernel_scale_m = thresholds.kernel_scale_m;
   out.registration = backend_->register_source(out.initial_guess, thresholds, reg, time_budget_s);
   out.registered = true;
@@ -118,7 +123,8 @@ bool ScanPipeline::restart_map_after_failures(std::int64_t stamp_ns, const Frame
 }
 
 FrameResult ScanPipeline::process(const Scan& input, const std::optional<SE3>& initial_guess,
-                                  const std::optional<deskew::ScanMotion>& motion, bool guess_from_fusion) {
+                                  const std::optional<deskew::ScanMotion>& motion, bool guess_from_fusion,
+                                  bool guess_confirmed) {
   auto t_start = Clock::now();
   FrameResult out;
   out.stamp_ns = input.end_stamp_ns;
@@ -137,11 +143,11 @@ FrameResult ScanPipeline::process(const Scan& input, const std::optional<SE3>& i
   const deskew::ScanMotion scan_motion =
       motion ? *motion
              : deskew::ScanMotion::constant_twist(last_twist().cast<float>(), static_cast<float>(scan.duration_s()));
-  preprocess(scan, scan_motion, out);                                       // 1.
-  const map::PointLimit limit = build_source(out);                          // 2.
-  register_scan(scan, scan_motion, initial_guess, guess_from_fusion, out);  // 3.
-  update_map(scan.end_stamp_ns, limit, out);                                // 4.
-  advance(scan.end_stamp_ns, out.pose, out);                                // 5.
+  preprocess(scan, scan_motion, out);                                                        // 1.
+  const map::PointLimit limit = build_source(out);                                           // 2.
+  register_scan(scan, scan_motion, initial_guess, guess_from_fusion, guess_confirmed, out);  // 3.
+  update_map(scan.end_stamp_ns, limit, out);                                                 // 4.
+  advance(scan.end_stamp_ns, out.pose, out);                                                 // 5.
   backend_->device_stage_times(out.timings);
   out.timings.total_s = seconds_since(t_start);
   return out;
@@ -190,7 +196,8 @@ map::PointLimit ScanPipeline::build_source(FrameResult& out) {
 }
 
 void ScanPipeline::register_scan(const Scan& scan, const deskew::ScanMotion& scan_motion,
-                                 const std::optional<SE3>& initial_guess, bool guess_from_fusion, FrameResult& out) {
+                                 const std::optional<SE3>& initial_guess, bool guess_from_fusion, bool guess_confirmed,
+                                 FrameResult& out) {
   const StageClock clock(out.timings.registration_s);
   const double period_s = frames_ > 0 && scan.end_stamp_ns > last_stamp_ns_
                               ? ns_to_seconds(scan.end_stamp_ns - last_stamp_ns_)
@@ -207,7 +214,7 @@ void ScanPipeline::register_scan(const Scan& scan, const deskew::ScanMotion& sca
   out.pose = out.initial_guess;
   if (backend_->map_voxels() > 0 && out.source_points > 0) {
     const double time_budget_s = config_.registration.time_budget_factor * period_s;
-    out.failure = register_frame(out, fused_guess, time_budget_s);
+    out.failure = register_frame(out, fused_guess, fused_guess && guess_confirmed, time_budget_s);
     if (out.failure.empty()) {
       out.pose = out.registration.pose;
       threshold_.update(out.initial_guess.inverse() * out.pose);

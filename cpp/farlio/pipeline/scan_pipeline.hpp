@@ -78,9 +78,12 @@ class ScanPipeline {
   /// undistortion) come from the fusion; when absent, the constant-velocity model supplies them.
   /// guess_from_fusion false: the guess is a LiDAR-only one (the constant-velocity translation
   /// with the gyro's rotation, before the filter is initialised) and registered as such.
+  /// guess_confirmed: the fusion's guess is confirmed (ScanPrior::confirmed): the kernel scale is
+  /// capped at registration.confirmed_kernel_scale_m instead of fused_kernel_scale_m.
   /// Points with NaN or Inf coordinates or times are dropped (FrameResult::non_finite_points).
   FrameResult process(const Scan& input, const std::optional<SE3>& initial_guess = std::nullopt,
-                      const std::optional<deskew::ScanMotion>& motion = std::nullopt, bool guess_from_fusion = true);
+                      const std::optional<deskew::ScanMotion>& motion = std::nullopt, bool guess_from_fusion = true,
+                      bool guess_confirmed = false);
 
   /// Replaces the initial pose; only before the first scan (throws std::logic_error after).
   void reset_initial_pose(const SE3& initial_pose);
@@ -118,7 +121,7 @@ class ScanPipeline {
   /// 3. Registration against the submap from the fusion's guess or the constant-velocity
   /// prediction (out: initial_guess, sigma_m, pose, failure, lost, ...).
   void register_scan(const Scan& scan, const deskew::ScanMotion& scan_motion, const std::optional<SE3>& initial_guess,
-                     bool guess_from_fusion, FrameResult& out);
+                     bool guess_from_fusion, bool guess_confirmed, FrameResult& out);
   /// After the first registration: when it found the body moving, this scan is undistorted again
   /// with that motion and the map starts again from it (out.map_started_here).
   void restart_map_with_found_motion(const Scan& scan, const deskew::ScanMotion& scan_motion, FrameResult& out);
@@ -129,7 +132,7 @@ class ScanPipeline {
   /// GICP of the frame's source from out.initial_guess at out.sigma_m (sets out.registration,
   /// registered, inlier_fraction, kernel_scale_m) over out.source_points; returns why its pose must
   /// not be used (empty when it may). fused_guess: the guess is the fusion's.
-  std::string register_frame(FrameResult& out, bool fused_guess, double time_budget_s);
+  std::string register_frame(FrameResult& out, bool fused_guess, bool guess_confirmed, double time_budget_s);
   /// Tracks failures in a row; after map_restart_after_s of them, empties the submap (a scan with
   /// points then starts it again) and returns true.
   bool restart_map_after_failures(std::int64_t stamp_ns, const FrameResult& result);
