@@ -1,7 +1,7 @@
 """Degeneracy: in the tunnel profile's 600 m bare section the scans do not fix the
 motion along the track. The registration holds that direction at the IMU prediction and the fusion
 gets only the scan's own step along it, at its covariance: the LIO's KITTI-style RPE stays under
-2 % (1.55 % measured) while LiDAR-only slides (12.6 %). docs/fusion.md "Degeneracy" has the table
+2 % (1.35 % measured) while LiDAR-only slides (12.6 %). docs/fusion.md "Degeneracy" has the table
 (`figures/fusion_tunnel.py`)."""
 
 from __future__ import annotations
