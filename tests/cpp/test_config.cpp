@@ -184,7 +184,7 @@ TEST(Config, ValidateCatchesFieldsSetDirectlyAndRulesBetweenFields) {
   c.map.initial_voxel_capacity = c.map.max_voxel_capacity + 1;
   EXPECT_NE(message_of(c).find("map.initial_voxel_capacity"), std::string::npos);
   c = Config();
-  c.map.voxel_size_m = 0.5;  // below auto_min_voxel_size_m while auto scaling is on
+  c.map.voxel_size_m = 0.4;  // below auto_min_voxel_size_m while auto scaling is on
   EXPECT_NE(message_of(c).find("map.auto_min_voxel_size_m"), std::string::npos);
   c.map.auto_voxel_size = false;
   EXPECT_EQ(message_of(c), "");

@@ -43,6 +43,15 @@ const Recording& handheld() {  // 50 scans through rooms: the sensor turns from 
   return r;
 }
 
+/// The same with every point: the registration must follow the turn from a deg/s gyro's guess (57
+/// times the turn) until the unit is decided. With a quarter of the points and the finer voxel of
+/// map.auto_min_voxels the registrations in the turn fail and the unit is never decided; with the
+/// range rule's voxel (map.auto_min_voxels 0) it is (docs/odometry.md, step 0).
+const Recording& handheld_every_point() {
+  static const Recording r = test::record(sim::Profile::Handheld, 5.0, 1);
+  return r;
+}
+
 bool contains(const std::vector<std::string>& warnings, const std::string& fragment) {
   return std::any_of(warnings.begin(), warnings.end(),
                      [&](const std::string& w) { return w.find(fragment) != std::string::npos; });
@@ -389,7 +398,7 @@ TEST(ReplayClocks, AFirstScanAfterTheImuEndsIsAnError) {
 }
 
 TEST(ReplayClocks, AGyroInDegreesPerSecondIsScaled) {
-  const Recording& rec = handheld();
+  const Recording& rec = handheld_every_point();
   std::vector<ImuSample> deg = rec.imu;
   for (auto& s : deg) s.gyro_rad_s *= kDegPerRad;
   const ReplayRun normal = replay(rec, rec.imu);

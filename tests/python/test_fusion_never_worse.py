@@ -99,3 +99,24 @@ def test_a_sparse_spinning_lidar_on_the_racetrack_is_no_worse_than_lidar_only(li
         assert lio[metric] <= lidar_only[metric], (metric, lio, lidar_only)
     assert lio["failed"] == lio["map_restarts"] == 0, lio
     assert lio.get("reinit") == 0, lio
+
+
+@pytest.mark.parametrize("seed", [1, 3])
+def test_a_forward_livox_carried_through_rooms_keeps_registering(seed):
+    """A forward-looking Livox Avia model carried through rooms and a bare corridor (handheld, 30 s):
+    facing close walls its scans fill few voxels. At the range rule's 1.33 m voxel they shrank to
+    70-150 source points, registrations failed and both modes were lost (LIO 1.2-4.4 m with 6-8
+    re-initialisations, LiDAR-only 3.4-90 m); the first scan now fills at least map.auto_min_voxels
+    voxels (0.87 m here): LIO 0.017-0.021 m without a failure, LiDAR-only 1.5-2.0 m (the narrow view
+    turning faster than its constant-velocity guess follows; docs/odometry.md, "Scale")."""
+    from farlio.simulation import Recording, make_config, replay, stretch_accuracy
+
+    rec = Recording(make_config("handheld", seed=seed, duration_s=30.0, lidar="avia"))
+    lio, lidar_only = stretch_accuracy(replay(rec, [])), stretch_accuracy(replay(rec, ["fusion.enabled=false"]))
+    print(f"handheld Avia seed {seed}: LIO {lio}, LiDAR-only {lidar_only}")
+    assert lio["ape_m"] <= 0.05 and lio["rot_deg"] <= 1.0, lio
+    for metric in ("ape_m", "rpe_pct", "rot_deg"):
+        assert lio[metric] <= lidar_only[metric], (metric, lio, lidar_only)
+    assert lio["failed"] == lio["map_restarts"] == lio["reinit"] == 0, lio
+    assert lidar_only["failed"] == lidar_only["map_restarts"] == 0, lidar_only
+    assert lidar_only["ape_m"] <= 3.0, lidar_only  # jumps, but is not lost

@@ -21,7 +21,7 @@ from farlio.simulation import generate
 # (profile, seconds, mode, scan-pose APE RMSE bound m, KITTI-style RPE bound %, 100 Hz odometry
 # APE bound m). Measured with a fixed 20 ms latency (seed 1), bounds ~3x above:
 #   urban 10 s     LIO: APE 0.006 m, RPE 0.05 %, odometry APE 0.007 m; LiDAR-only: 0.008 m, 0.07 %
-#   handheld 25 s  LIO: APE 0.006 m, RPE 0.12 %, odometry APE 0.007 m; LiDAR-only: 0.093 m, 2.0 %
+#   handheld 25 s  LIO: APE 0.005 m, RPE 0.07 %, odometry APE 0.006 m; LiDAR-only: 0.070 m, 2.0 %
 #   (these two: figures/odometry_accuracy.py)
 #   racetrack 6 s  LIO: APE 0.040 m, RPE 0.23 %, odometry APE 0.049 m; LiDAR-only: 0.053 m, 0.31 %
 #                  (standing start, launch to 12 m/s: the case of docs/odometry.md "racetrack launch")

@@ -34,9 +34,23 @@ std::vector<std::int32_t> voxel_downsample(const std::vector<Eigen::Vector3f>& p
   return kept;
 }
 
+std::size_t occupied_voxels(const std::vector<Eigen::Vector3f>& points, double voxel_m, std::size_t max_points) {
+  const std::size_t stride = std::max<std::size_t>(1, (points.size() + max_points - 1) / max_points);
+  std::vector<std::uint64_t> keys;
+  keys.reserve(points.size() / stride + 1);
+  const auto inv = static_cast<float>(1.0 / voxel_m);
+  for (std::size_t i = 0; i < points.size(); i += stride) {
+    if (points[i].allFinite()) keys.push_back(map::point_key(points[i], inv));
+  }
+  std::sort(keys.begin(), keys.end());
+  return static_cast<std::size_t>(std::unique(keys.begin(), keys.end()) - keys.begin());
+}
+
 double scene_voxel_size_m(const std::vector<Eigen::Vector3f>& points, const VoxelMapConfig& config) {
   constexpr std::size_t kStride = 16;  // a subsample is enough for a percentile
   constexpr double kPercentile = 0.9;
+  constexpr std::size_t kCountedPoints = 1 << 16;  // enough to count voxels of 0.5 m and more
+  constexpr double kShrink = 0.9;                  // the voxel's step down while too few are filled
   if (!config.auto_voxel_size) return config.voxel_size_m;
   std::vector<float> ranges;
   for (std::size_t i = 0; i < points.size(); i += kStride) {
@@ -46,8 +60,13 @@ double scene_voxel_size_m(const std::vector<Eigen::Vector3f>& points, const Voxe
   if (ranges.empty()) return config.voxel_size_m;
   const auto nth = ranges.begin() + static_cast<std::ptrdiff_t>(kPercentile * static_cast<double>(ranges.size() - 1));
   std::nth_element(ranges.begin(), nth, ranges.end());
-  return std::clamp(static_cast<double>(*nth) / config.auto_range_ratio, config.auto_min_voxel_size_m,
-                    config.voxel_size_m);
+  double voxel = std::clamp(static_cast<double>(*nth) / config.auto_range_ratio, config.auto_min_voxel_size_m,
+                            config.voxel_size_m);
+  while (voxel > config.auto_min_voxel_size_m &&
+         occupied_voxels(points, voxel, kCountedPoints) < static_cast<std::size_t>(config.auto_min_voxels)) {
+    voxel = std::max(config.auto_min_voxel_size_m, voxel * kShrink);
+  }
+  return voxel;
 }
 
 }  // namespace farlio::preprocess

@@ -18,6 +18,10 @@ std::vector<std::int32_t> voxel_downsample(const std::vector<Eigen::Vector3f>& p
                                            const std::vector<std::int32_t>& indices, float cell_m,
                                            exec::CpuExecutor& executor);
 
+/// Voxels of size `voxel_m` that `points` fill (counted over at most `max_points` of them, evenly
+/// spaced).
+std::size_t occupied_voxels(const std::vector<Eigen::Vector3f>& points, double voxel_m, std::size_t max_points);
+
 /// The voxel size for a scene whose first scan is `points` (sensor frame): see
 /// VoxelMapConfig::auto_voxel_size. Returns config.voxel_size_m when auto is off or the scan
 /// is empty.
