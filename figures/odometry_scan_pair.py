@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """How well-determined is ../shared/data/real/scan_pair? (docs/odometry.md, "Measured figures": the
-real scan pair.) Registers it with farlio (4, 2 and 1 m voxels) and, if the `small_gicp` package is
+real scan pair.) Registers it with farlio (the automatic voxel, 4, 2 and 1 m) and, if the `small_gicp` package is
 installed (pip install small_gicp), with small_gicp's factors at several downsampling resolutions,
 printing each result's distance to T_target_source.txt. Used to set the bounds of
 tests/cpp/test_scan_pair.cpp.
@@ -33,9 +33,11 @@ def main() -> None:
     gt = np.loadtxt(data / "T_target_source.txt")
     src = _core.io.read_point_cloud(data / "source.ply")
     tgt = _core.io.read_point_cloud(data / "target.ply")
-    for voxel in (4.0, 2.0, 1.0):
+    for voxel in ("auto", 4.0, 2.0, 1.0):
         cfg = _core.Config()
-        cfg.set("map.voxel_size_m", str(voxel))
+        if voxel != "auto":  # a fixed size (auto picks one no larger than map.voxel_size_m)
+            cfg.set("map.auto_voxel_size", "false")
+            cfg.set("map.voxel_size_m", str(voxel))
         r = _core.register_pair(src, tgt, farlio.SE3(), cfg)
         print(
             f"farlio voxel {voxel} m: translation {error(gt, r.pose.matrix())[0]:.4f} m, "
