@@ -83,7 +83,11 @@ std::size_t brute_force_voxels(const std::vector<Eigen::Vector3f>& points, doubl
 TEST(SceneScale, OccupiedVoxelsAreABruteForceCount) {
   const auto points = room_scan(false, 5000, 1);
   for (double voxel : {0.3, 0.7, 1.3, 4.0}) {
-    EXPECT_EQ(preprocess::occupied_voxels(points, voxel, points.size()), brute_force_voxels(points, voxel)) << voxel;
+    const std::size_t all = brute_force_voxels(points, voxel);
+    EXPECT_EQ(preprocess::occupied_voxels(points, voxel, points.size()), all) << voxel;
+    // the count stops at `enough`, and counts them all when there are fewer
+    EXPECT_EQ(preprocess::occupied_voxels(points, voxel, points.size(), all / 2), all / 2) << voxel;
+    EXPECT_EQ(preprocess::occupied_voxels(points, voxel, points.size(), all + 1), all) << voxel;
   }
 }
 

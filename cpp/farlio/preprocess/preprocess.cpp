@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <unordered_set>
 
 #include "farlio/map/voxel_update.hpp"
 #include "farlio/preprocess/cell_downsampler.hpp"
@@ -34,16 +35,15 @@ std::vector<std::int32_t> voxel_downsample(const std::vector<Eigen::Vector3f>& p
   return kept;
 }
 
-std::size_t occupied_voxels(const std::vector<Eigen::Vector3f>& points, double voxel_m, std::size_t max_points) {
+std::size_t occupied_voxels(const std::vector<Eigen::Vector3f>& points, double voxel_m, std::size_t max_points,
+                            std::size_t enough) {
   const std::size_t stride = std::max<std::size_t>(1, (points.size() + max_points - 1) / max_points);
-  std::vector<std::uint64_t> keys;
-  keys.reserve(points.size() / stride + 1);
   const auto inv = static_cast<float>(1.0 / voxel_m);
-  for (std::size_t i = 0; i < points.size(); i += stride) {
-    if (points[i].allFinite()) keys.push_back(map::point_key(points[i], inv));
+  std::unordered_set<std::uint64_t> keys;
+  for (std::size_t i = 0; i < points.size() && keys.size() < enough; i += stride) {
+    if (points[i].allFinite()) keys.insert(map::point_key(points[i], inv));
   }
-  std::sort(keys.begin(), keys.end());
-  return static_cast<std::size_t>(std::unique(keys.begin(), keys.end()) - keys.begin());
+  return keys.size();
 }
 
 double scene_voxel_size_m(const std::vector<Eigen::Vector3f>& points, const VoxelMapConfig& config) {
@@ -60,10 +60,10 @@ double scene_voxel_size_m(const std::vector<Eigen::Vector3f>& points, const Voxe
   if (ranges.empty()) return config.voxel_size_m;
   const auto nth = ranges.begin() + static_cast<std::ptrdiff_t>(kPercentile * static_cast<double>(ranges.size() - 1));
   std::nth_element(ranges.begin(), nth, ranges.end());
+  const auto enough = static_cast<std::size_t>(config.auto_min_voxels);
   double voxel = std::clamp(static_cast<double>(*nth) / config.auto_range_ratio, config.auto_min_voxel_size_m,
                             config.voxel_size_m);
-  while (voxel > config.auto_min_voxel_size_m &&
-         occupied_voxels(points, voxel, kCountedPoints) < static_cast<std::size_t>(config.auto_min_voxels)) {
+  while (voxel > config.auto_min_voxel_size_m && occupied_voxels(points, voxel, kCountedPoints, enough) < enough) {
     voxel = std::max(config.auto_min_voxel_size_m, voxel * kShrink);
   }
   return voxel;
