@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <random>
 #include <set>
 #include <tuple>
@@ -16,8 +17,6 @@
 using namespace farlio;
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 /// Where a ray from the origin along `d` leaves the box [lo, hi] (the origin inside it).
 Eigen::Vector3f exit_point(const Eigen::Vector3d& d, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
@@ -41,7 +40,9 @@ std::vector<Eigen::Vector3f> room_scan(bool narrow, std::size_t n, unsigned seed
     if (d.norm() > 1.0 || d.norm() < 1e-3) continue;  // uniform directions: inside the unit ball
     const Eigen::Vector3d dir = d.normalized();
     const double azimuth = std::atan2(dir.y(), dir.x()), elevation = std::asin(dir.z());
-    if (narrow && (std::abs(azimuth) > 35.0 * kPi / 180.0 || std::abs(elevation) > 38.5 * kPi / 180.0)) continue;
+    if (narrow &&
+        (std::abs(azimuth) > 35.0 * std::numbers::pi / 180.0 || std::abs(elevation) > 38.5 * std::numbers::pi / 180.0))
+      continue;
     points.push_back(exit_point(dir, lo, hi));
   }
   return points;
@@ -50,7 +51,8 @@ std::vector<Eigen::Vector3f> room_scan(bool narrow, std::size_t n, unsigned seed
 /// An open scene: ground 1.8 m below a spinning sensor, out to 80 m, with a few building walls.
 std::vector<Eigen::Vector3f> outdoor_scan(std::size_t n, unsigned seed) {
   std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> angle(-kPi, kPi), range(3.0, 80.0), height(-1.8, 8.0);
+  std::uniform_real_distribution<double> angle(-std::numbers::pi, std::numbers::pi), range(3.0, 80.0),
+      height(-1.8, 8.0);
   std::vector<Eigen::Vector3f> points;
   for (std::size_t i = 0; i < n; ++i) {
     const double a = angle(rng);
