@@ -113,6 +113,11 @@ void bind_fusion_stats(nb::module_& m) {
       .def_ro("gyro_bias_rad_s", &fusion::FusionStats::gyro_bias_rad_s)
       .def_ro("accel_bias_m_s2", &fusion::FusionStats::accel_bias_m_s2)
       .def_ro("last_warning", &fusion::FusionStats::last_warning)
+      .def_ro("measured_gyro_step_std_rad_s", &fusion::FusionStats::measured_gyro_step_std_rad_s,
+              "the gyro's noise measured on its samples, averaged over a filter step (0 before the first estimate)")
+      .def_ro("measured_accel_step_std_m_s2", &fusion::FusionStats::measured_accel_step_std_m_s2,
+              "the accelerometer's noise measured on its samples, averaged over a filter step")
+      .def_ro("imu_rate_hz", &fusion::FusionStats::imu_rate_hz, "the IMU's sample rate (0 before the first estimate)")
       .def("__repr__", attribute_repr({"steps", "lidar_groups_accepted", "lidar_groups_rejected", "reinitializations",
                                        "imu_gaps", "imu_samples_dropped", "imu_samples_rejected", "accel_in_g",
                                        "gyro_bias_rad_s", "last_warning"}));

@@ -336,7 +336,7 @@ class OdometryRun:
         }
         stats = self.odo.fusion_stats
         if stats is not None:
-            summary["fusion"] = _fusion_summary(stats)
+            summary["fusion"] = _fusion_summary(stats, self.config)
             init = summary["fusion"]["initialization"]
             if init["stamp_ns"] is not None and len(self.lidar_poses):
                 init["after_first_scan_s"] = (init["stamp_ns"] - self.lidar_poses[0][0]) / NS_PER_S
@@ -407,7 +407,7 @@ class OdometryRun:
         (self.out_dir / SUMMARY_JSON).write_text(json.dumps(summary, indent=2, default=_json_default))
 
 
-def _fusion_summary(stats: Any) -> dict[str, Any]:
+def _fusion_summary(stats: Any, config: Any) -> dict[str, Any]:
     """The fusion's counters for summary.json; warns about an accelerometer in g and IMU gaps."""
     if stats.accel_in_g:
         _warn(stats.accel_unit_message)
@@ -444,7 +444,44 @@ def _fusion_summary(stats: Any) -> dict[str, Any]:
         "accel_in_g": stats.accel_in_g,
         "gyro_bias_rad_s": list(stats.gyro_bias_rad_s),
         "accel_bias_m_s2": list(stats.accel_bias_m_s2),
+        # the IMU as measured on its samples; the filter's input noise is the larger of this and
+        # fusion.gyro_input_std_rad_s / accel_input_std_m_s2
+        "imu": {
+            "rate_hz": stats.imu_rate_hz,
+            "step_s": config.get("fusion.step_s"),
+            "gyro_step_std_rad_s": stats.measured_gyro_step_std_rad_s,
+            "accel_step_std_m_s2": stats.measured_accel_step_std_m_s2,
+            "gyro_input_std_rad_s": config.get("fusion.gyro_input_std_rad_s"),
+            "accel_input_std_m_s2": config.get("fusion.accel_input_std_m_s2"),
+        },
     }
+
+
+def _imu_lines(imu: dict[str, float]) -> list[str]:
+    """One line each where the IMU is slower than the filter's step or noisier than its defaults."""
+    lines = []
+    step_s = imu["step_s"]
+    if 0.0 < imu["rate_hz"] < 0.9 / step_s:
+        lines.append(
+            f"IMU at {imu['rate_hz']:.0f} Hz, slower than the filter's {1.0 / step_s:.0f} Hz step: its samples are "
+            f"interpolated between the steps, and the {1.0 / step_s:.0f} Hz output follows the newest sample "
+            f"(up to {1e3 / imu['rate_hz']:.0f} ms after its instant)"
+        )
+    noisier = [
+        f"{name} {imu[measured]:.3g} {unit} (fusion.{floor} {imu[floor]:.3g})"
+        for name, measured, unit, floor in (
+            ("gyro", "gyro_step_std_rad_s", "rad/s", "gyro_input_std_rad_s"),
+            ("accelerometer", "accel_step_std_m_s2", "m/s^2", "accel_input_std_m_s2"),
+        )
+        if imu[measured] > imu[floor]
+    ]
+    if noisier:
+        lines.append(
+            f"IMU noise over a {1e3 * step_s:.0f} ms step, measured on its samples: "
+            + ", ".join(noisier)
+            + ": the filter uses the measured noise"
+        )
+    return lines
 
 
 def _json_default(o: Any) -> Any:
@@ -486,6 +523,7 @@ def format_summary(s: dict[str, Any]) -> str:
                 f"fusion: initialised {init['mode']}, {init.get('after_first_scan_s', 0.0):.2f} s after the first scan "
                 f"({init['window_scans']} scans, {init['speed_m_s']:.1f} m/s); world z {tilt:.1f} deg from up"
             )
+        lines.extend(_imu_lines(s["fusion"]["imu"]))
     loc = s.get("localization")
     if loc:
         lines.append(

@@ -6,6 +6,9 @@
 
 using namespace farlio;
 using namespace farlio::test;
+using fusion::InputVector;
+using fusion::kAccelIndex;
+using fusion::kGyroIndex;
 
 namespace {
 TestTrajectory fast_curve() { return {}; }  // 30 m/s, 1 rad/s yaw rate, roll/pitch/height wobble
@@ -186,6 +189,36 @@ TEST(FusionSensor, ImuGapIsBridgedAndCounted) {
   EXPECT_LT(r.max_position_error_m(6.5), 0.10);  // recovered
   std::printf("IMU gap: max position error %.3f m overall, %.3f m after 6.5 s\n", r.max_position_error_m(),
               r.max_position_error_m(6.5));
+}
+
+TEST(FusionSensor, AnImuNoisierThanTheConfiguredInputNoiseIsUsedAsMeasured) {
+  // a vibrating race car's IMU at 800 Hz (3e-3 rad/s/sqrt(Hz), 7e-2 m/s^2/sqrt(Hz)): over a 10 ms
+  // step its gyro spreads by 0.030 rad/s, above the configured 0.02, and its accelerometer by
+  // 0.70 m/s^2, below the configured 1.0
+  SimOptions o = noisy_options(3.0);
+  o.imu_hz = 800.0;
+  o.gyro_noise_std_rad_s = 3e-3 * std::sqrt(o.imu_hz);
+  o.accel_noise_std_m_s2 = 7e-2 * std::sqrt(o.imu_hz);
+  const FusionConfig config;
+  fusion::SensorFusion f(config, kGravity_m_s2);
+  const InputVector before = f.input_std();
+  EXPECT_DOUBLE_EQ(before[kAccelIndex], config.accel_input_std_m_s2);
+  EXPECT_DOUBLE_EQ(before[kGyroIndex], config.gyro_input_std_rad_s);
+  const SimResult r = simulate(fast_curve(), config, o, &f);
+  ASSERT_TRUE(r.finite);
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_NEAR(f.input_std()[kGyroIndex + a], 0.030, 0.003) << "gyro axis " << a;
+    EXPECT_DOUBLE_EQ(f.input_std()[kAccelIndex + a], config.accel_input_std_m_s2) << "accel axis " << a;
+  }
+  EXPECT_NEAR(f.stats().measured_accel_step_std_m_s2, 0.70, 0.07);
+  EXPECT_NEAR(f.stats().imu_rate_hz, 800.0, 1.0);
+  // the quieter IMU of the noisy scenarios (200 Hz, 0.005 rad/s and 0.05 m/s^2 a sample) keeps the
+  // configured floors
+  fusion::SensorFusion quiet(matched_config(), kGravity_m_s2);
+  ASSERT_TRUE(simulate(slow_curve(), matched_config(), noisy_options(8.0), &quiet).finite);
+  EXPECT_DOUBLE_EQ(quiet.input_std()[kGyroIndex], matched_config().gyro_input_std_rad_s);
+  EXPECT_DOUBLE_EQ(quiet.input_std()[kAccelIndex], matched_config().accel_input_std_m_s2);
+  EXPECT_NEAR(quiet.stats().measured_gyro_step_std_rad_s, 0.005 / std::sqrt(2.0), 0.0007);
 }
 
 TEST(FusionSensor, TooOldLidarAndOutOfOrderImuAreRejected) {

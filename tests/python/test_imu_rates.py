@@ -39,3 +39,54 @@ def test_a_10_hz_imu_off_the_scans_clock_is_fused(seed):
     assert lio["rejected"] == 0 and lio["reinit"] == 0, lio
     for metric in ("ape_m", "rpe_pct"):
         assert lio[metric] <= lidar_only[metric], (metric, lio, lidar_only)
+
+
+#: a vibrating race car's IMU: white noise densities (rad/s/sqrt(Hz), m/s^2/sqrt(Hz))
+RACING_GYRO_DENSITY, RACING_ACCEL_DENSITY = 3e-3, 7e-2
+
+
+def _summary_lines(run) -> tuple[dict, list[str]]:
+    from farlio import _core
+    from farlio.runner import _fusion_summary, _imu_lines
+
+    summary = _fusion_summary(run.stats, _core.Config())
+    return summary["imu"], _imu_lines(summary["imu"])
+
+
+def test_a_vibrating_race_cars_imu_noise_is_measured_used_and_said():
+    """The fusion measures the IMU's noise on its samples (docs/fusion.md, "A noisy IMU"): a vibrating
+    race car's at 800 Hz spreads by 0.030 rad/s and 0.70 m/s^2 over a 10 ms step, its true values; the
+    gyro's is above the configured fusion.gyro_input_std_rad_s (0.02), so the filter takes it as its
+    input noise, and the run says so in one line. The profile's quieter IMU (0.007 rad/s, 0.18 m/s^2)
+    keeps the configured noise, without a line."""
+    import math
+
+    rate = make_config("racetrack").imu_rate_hz
+    noisy = {
+        "gyro_noise_std_rad_s": RACING_GYRO_DENSITY * math.sqrt(rate),
+        "accel_noise_std_m_s2": RACING_ACCEL_DENSITY * math.sqrt(rate),
+    }
+    step_s = 0.01
+    imu, lines = _summary_lines(replay(Recording(make_config("racetrack", seed=1, duration_s=4.0, **noisy)), []))
+    print("racing IMU", imu, lines)
+    assert imu["rate_hz"] == pytest.approx(rate, rel=1e-3)
+    assert imu["gyro_step_std_rad_s"] == pytest.approx(RACING_GYRO_DENSITY / math.sqrt(step_s), rel=0.1)
+    assert imu["accel_step_std_m_s2"] == pytest.approx(RACING_ACCEL_DENSITY / math.sqrt(step_s), rel=0.1)
+    assert len(lines) == 1 and "gyro" in lines[0] and "accelerometer" not in lines[0], lines
+    assert "the filter uses the measured noise" in lines[0]
+
+    imu, lines = _summary_lines(replay(Recording(make_config("racetrack", seed=1, duration_s=4.0)), []))
+    print("profile IMU", imu, lines)
+    assert 0.0 < imu["gyro_step_std_rad_s"] < imu["gyro_input_std_rad_s"], imu
+    assert 0.0 < imu["accel_step_std_m_s2"] < imu["accel_input_std_m_s2"], imu
+    assert lines == []
+
+
+def test_a_10_hz_imu_is_said_in_one_line():
+    """KITTI raw's OXTS rate: the fusion finds the rate on the samples within 10 s and the run says
+    that the 100 Hz output follows the newest sample, up to 100 ms after its instant."""
+    rec = Recording(make_config("urban", seed=1, duration_s=12.0, imu_rate_hz=10.0))
+    imu, lines = _summary_lines(replay(rec, []))
+    print("10 Hz IMU", imu, lines)
+    assert imu["rate_hz"] == pytest.approx(10.0, rel=1e-3)
+    assert len(lines) == 1 and lines[0].startswith("IMU at 10 Hz") and "up to 100 ms" in lines[0], lines

@@ -187,11 +187,11 @@ inline constexpr double kMaxThreads = 1024.0;
   FIELD(double, max_extrapolation_s, 0.1, range::non_negative_up_to(kMaxDuration_s),                                  \
         "a pose may be predicted this far beyond the newest step")                                                    \
   FIELD(double, gyro_input_std_rad_s, 0.02, range::positive_up_to(kMaxSiValue),                                       \
-        "std of the gyro input averaged over one step, process noise B Q B^T "                                        \
-        "(reference: variances 3e-4..3e-3 rad^2/s^2 at 100 Hz)")                                                      \
+        "std of the gyro input averaged over one step, process noise B Q B^T (reference: variances "                  \
+        "3e-4..3e-3 rad^2/s^2 at 100 Hz); the least used: a gyro measured noisier on its samples gets its own")       \
   FIELD(double, accel_input_std_m_s2, 1.0, range::positive_up_to(kMaxSiValue),                                        \
-        "std of the accelerometer input averaged over one step, process noise B Q B^T "                               \
-        "(reference: variances 1..4 m^2/s^4 at 100 Hz)")                                                              \
+        "std of the accelerometer input averaged over one step, process noise B Q B^T (reference: variances "         \
+        "1..4 m^2/s^4 at 100 Hz); the least used: an accelerometer measured noisier on its samples gets its own")     \
   FIELD(double, lidar_position_std_m, 0.05, range::positive_up_to(kMaxSiValue),                                       \
         "LiDAR position measurement std per axis")                                                                    \
   FIELD(double, lidar_roll_pitch_std_rad, 0.02, range::positive_up_to(kMaxSiValue),                                   \

@@ -18,6 +18,9 @@ class KinematicEkf {
                const InputVector& bias_walk_variance = InputVector::Zero());
 
   void initialize(const StateVector& x, const StateMatrix& P);
+  /// Replaces the input noise Q (the same units as the constructor's).
+  void set_input_variance(const InputVector& input_variance) { Q_ = input_variance.asDiagonal(); }
+  [[nodiscard]] InputVector input_variance() const { return Q_.diagonal(); }
   [[nodiscard]] bool initialized() const { return initialized_; }
 
   /// Propagates the state over dt_s with the input at the step start, middle and end.

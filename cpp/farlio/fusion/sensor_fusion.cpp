@@ -31,10 +31,16 @@ constexpr double kMaxGravityNormError = 0.1;
 
 double square(double v) { return v * v; }
 
-InputVector input_variance(const FusionConfig& c) {
+/// The input noise over one step: the configured stds, or the IMU's measured noise where larger.
+InputVector input_variance(const FusionConfig& c, const std::optional<ImuNoise>& measured = std::nullopt) {
+  Eigen::Vector3d accel = Eigen::Vector3d::Constant(c.accel_input_std_m_s2);
+  Eigen::Vector3d gyro = Eigen::Vector3d::Constant(c.gyro_input_std_rad_s);
+  if (measured) {
+    accel = accel.cwiseMax(measured->accel_step_std_m_s2(c.step_s));
+    gyro = gyro.cwiseMax(measured->gyro_step_std_rad_s(c.step_s));
+  }
   InputVector q;
-  q << Eigen::Vector3d::Constant(square(c.accel_input_std_m_s2)),
-      Eigen::Vector3d::Constant(square(c.gyro_input_std_rad_s));
+  q << accel.cwiseAbs2(), gyro.cwiseAbs2();
   return q;
 }
 
@@ -117,6 +123,8 @@ void SensorFusion::add_imu(const ImuSample& sample) {
     return;
   }
   accel_unit_.add(sample.accel_m_s2);
+  imu_noise_.add(sample.stamp_ns, sample.gyro_rad_s, accel_unit_.scale() * sample.accel_m_s2);
+  if (imu_noise_.updated()) ekf_.set_input_variance(input_variance(config_, imu_noise_.noise()));
   if (config_.standstill.gyro_bias && initialized() && accel_unit_.decided()) {
     const double speed_m_s = ekf_.state().segment<3>(kVelocityIndex).norm();
     bias_.add(sample.gyro_rad_s, accel_unit_.scale() * sample.accel_m_s2, speed_m_s);
@@ -459,6 +467,11 @@ FusionStats SensorFusion::stats() const {
     s.accel_bias_m_s2 += ekf_.state().segment<3>(kAccelBiasIndex);
   }
   s.bias_samples = static_cast<std::int64_t>(bias_.sample_count());
+  if (const auto& noise = imu_noise_.noise()) {
+    s.measured_gyro_step_std_rad_s = noise->gyro_step_std_rad_s(config_.step_s).maxCoeff();
+    s.measured_accel_step_std_m_s2 = noise->accel_step_std_m_s2(config_.step_s).maxCoeff();
+    s.imu_rate_hz = noise->sample_period_s > 0.0 ? 1.0 / noise->sample_period_s : 0.0;
+  }
   if (initialized())
     s.up_map = map_from_level() * level_from_world(ekf_.state()).transpose() * Eigen::Vector3d::UnitZ();
   return s;

@@ -23,6 +23,7 @@
 #include "farlio/fusion/delay_compensation.hpp"
 #include "farlio/fusion/imu_buffer.hpp"
 #include "farlio/fusion/imu_gate.hpp"
+#include "farlio/fusion/imu_noise.hpp"
 #include "farlio/fusion/initialization.hpp"
 #include "farlio/fusion/kinematic_ekf.hpp"
 #include "farlio/fusion/reference_angles.hpp"
@@ -58,6 +59,12 @@ struct FusionStats {
   Eigen::Vector3d accel_bias_m_s2 = Eigen::Vector3d::Zero();  ///< configured + filter state
   std::int64_t bias_samples = 0;
   std::string last_warning;  ///< the most recent warning, empty if none
+  /// The IMU's noise measured on its samples (imu_noise.hpp), averaged over a filter step (largest
+  /// axis; 0 before the first estimate), and its sample rate; the filter's input noise is the
+  /// larger of this and fusion.gyro_input_std_rad_s / accel_input_std_m_s2.
+  double measured_gyro_step_std_rad_s = 0.0;
+  double measured_accel_step_std_m_s2 = 0.0;
+  double imu_rate_hz = 0.0;
 };
 
 /// Which groups of one LiDAR result were accepted.
@@ -105,6 +112,9 @@ class SensorFusion {
   /// Gravity in the map frame as now estimated, and the window, for a filter that takes over.
   [[nodiscard]] MapFrameKnowledge map_frame_knowledge() const;
   [[nodiscard]] const FusionConfig& config() const { return config_; }
+  /// The filter's input noise over a step [accel (m/s^2), gyro (rad/s)]: the configured stds, or
+  /// the IMU's noise measured on its samples where larger (imu_noise.hpp).
+  [[nodiscard]] InputVector input_std() const { return ekf_.input_variance().cwiseSqrt(); }
   /// The filter step (FusionConfig::step_s) in ns.
   [[nodiscard]] std::int64_t step_ns() const { return step_ns_; }
   /// The filter's time: its newest step (valid once initialised).
@@ -162,6 +172,7 @@ class SensorFusion {
   ImuGate imu_gate_;
   AccelUnitDetector accel_unit_;
   StandstillGyroBias bias_;
+  ImuNoiseMeter imu_noise_;
   ReferenceAngleEstimator reference_;
   StateHistory history_;
   SpreadMeasurementQueue queue_;
