@@ -64,8 +64,8 @@ void ImuNoiseMeter::add(std::int64_t stamp_ns, const Eigen::Vector3d& gyro_rad_s
   }
   before_previous_ = previous_;
   previous_ = sample;
-  const bool long_enough = gyro_differences_.size() >= kMinBatchSamples &&
-                           ns_to_seconds(stamp_ns - batch_start_ns_) >= kMaxBatch_s;
+  const bool long_enough =
+      gyro_differences_.size() >= kMinBatchSamples && ns_to_seconds(stamp_ns - batch_start_ns_) >= kMaxBatch_s;
   if (gyro_differences_.size() < kBatchSamples && !long_enough) return;
   ++batches_;
   const double weight = 1.0 / std::min(static_cast<double>(batches_), kMemoryBatches);

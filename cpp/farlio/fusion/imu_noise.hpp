@@ -8,9 +8,10 @@
 // the median |second difference| over a batch of kBatchSamples samples gives the std of one sample
 // (median / 0.6745 / sqrt(6): robust to a bump), a batch's estimate good to about 5 %; the
 // estimate is the mean of the batches' variances over the last kMemoryBatches. Averaged over a
-// filter step of n samples the input's std is that / sqrt(n). Measured on the simulator's IMUs (std over a 10 ms step): racetrack
-// 0.007 rad/s and 0.18 m/s^2, urban 0.003 and 0.05, handheld 0.0035 and 0.056; a vibrating race car's
-// (3e-3 rad/s/sqrt(Hz), 7e-2 m/s^2/sqrt(Hz) at 800 Hz) 0.030 and 0.70: its true values.
+// filter step of n samples the input's std is that / sqrt(n). Measured on the simulator's IMUs
+// (std over a 10 ms step): racetrack 0.007 rad/s and 0.18 m/s^2, urban 0.003 and 0.05, handheld
+// 0.0035 and 0.056; a vibrating race car's (3e-3 rad/s/sqrt(Hz), 7e-2 m/s^2/sqrt(Hz) at 800 Hz)
+// 0.030 and 0.70: its true values.
 #include <Eigen/Core>
 #include <cstddef>
 #include <cstdint>
