@@ -22,7 +22,6 @@ import argparse
 import math
 
 import numpy as np
-
 from farlio.simulation import LIDAR_MODELS, PROFILES, Recording, make_config, replay, stretch_accuracy
 from harness import FIXED_LATENCY_S, LIDAR_ONLY
 
