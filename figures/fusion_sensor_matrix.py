@@ -7,7 +7,8 @@ For each profile, LiDAR model and seed the generator records `--duration` second
 (`farlio simulate PROFILE --lidar L`, in memory), and the deterministic replay (fixed 20 ms latency)
 runs it with the IMU and with `fusion.enabled=false`. One markdown row per profile and LiDAR: the
 scan poses' APE (m, aligned RMSE), KITTI-style RPE (%), rotation RMSE (deg) after the APE's
-alignment and rotation RMSE from the first pose (deg, rotation_from_origin_deg) of both modes, each
+alignment and rotation RMSE from the first pose (deg, farlio.simulation.rotation_from_origin_deg) of
+both modes, each
 cell the seeds separated by " / ", a metric in bold where the LIO is worse than LiDAR-only on some
 seed; then the LIO's registration failures, re-initialisations and rejected LiDAR groups, summed
 over the seeds, and whether its filter started (a narrow field of view on the racetrack never
@@ -19,30 +20,12 @@ gives it the scans that constrain every direction it starts from: docs/fusion.md
 from __future__ import annotations
 
 import argparse
-import math
 
-import numpy as np
 from farlio.simulation import LIDAR_MODELS, PROFILES, Recording, make_config, replay, stretch_accuracy
 from harness import FIXED_LATENCY_S, LIDAR_ONLY
 
 METRICS = ("ape_m", "rpe_pct", "rot_deg", "rot_origin_deg")
 DECIMALS = {"ape_m": 3, "rpe_pct": 3, "rot_deg": 3, "rot_origin_deg": 3}
-
-
-def rotation_from_origin_deg(rec: Recording, run) -> float:
-    """RMS of the scan poses' rotation error relative to the first pose (the trajectories aligned at
-    their first pose, as evo's --align_origin): unlike rot_deg (after the APE's alignment of the
-    positions), it sees a roll about a nearly straight path, the way the map frame was levelled."""
-    stamps = np.asarray(run.scans.stamps_ns)
-    poses = np.asarray(run.scans.matrices())
-    truth = {s: np.asarray(p.matrix()) for s, p in rec.gt_scans}
-    g0 = truth[int(stamps[0])][:3, :3]
-    errors = []
-    for s, m in zip(stamps, poses):
-        g = g0.T @ truth[int(s)][:3, :3]
-        e = poses[0][:3, :3].T @ m[:3, :3]
-        errors.append(math.degrees(math.acos(max(-1.0, min(1.0, (np.trace(g.T @ e) - 1.0) / 2.0)))))
-    return float(np.sqrt(np.mean(np.square(errors))))
 
 
 def cell(values: list[float], metric: str) -> str:
@@ -71,7 +54,7 @@ def main() -> int:
                 rec = Recording(make_config(profile, seed=seed, duration_s=args.duration, lidar=lidar))
                 for rows, overrides in ((lio, []), (lo, [LIDAR_ONLY])):
                     run = replay(rec, overrides, fixed_latency_s=FIXED_LATENCY_S)
-                    rows.append(stretch_accuracy(run) | {"rot_origin_deg": rotation_from_origin_deg(rec, run)})
+                    rows.append(stretch_accuracy(run))
             row = [f"{profile}, {lidar}"]
             for metric in METRICS:
                 a, b = [r[metric] for r in lio], [r[metric] for r in lo]
