@@ -4,20 +4,14 @@
 #include <sstream>
 #include <vector>
 
+#include "farlio/fusion/axis_median.hpp"
+
 namespace farlio::fusion {
 namespace {
 
 /// The per-axis median of one vector field of the samples.
 Eigen::Vector3d median(const std::deque<ImuSample>& samples, Vec3d ImuSample::*field) {
-  Eigen::Vector3d m;
-  std::vector<double> values(samples.size());
-  for (int axis = 0; axis < 3; ++axis) {
-    for (std::size_t i = 0; i < samples.size(); ++i) values[i] = (samples[i].*field)(axis);
-    const auto mid = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-    std::nth_element(values.begin(), mid, values.end());
-    m(axis) = *mid;
-  }
-  return m;
+  return axis_median(samples, [field](const ImuSample& s) { return s.*field; });
 }
 
 std::string describe(const char* what, const Eigen::Vector3d& v, const char* unit) {

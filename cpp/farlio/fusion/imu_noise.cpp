@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "farlio/core/time.hpp"
+#include "farlio/fusion/axis_median.hpp"
 
 namespace farlio::fusion {
 namespace {
@@ -21,14 +22,9 @@ double median(std::vector<double>& v) {
 
 /// The std of one sample per axis from the second differences.
 Eigen::Vector3d sample_std(const std::vector<Eigen::Vector3d>& differences) {
-  Eigen::Vector3d out;
-  std::vector<double> axis(differences.size());
-  for (int a = 0; a < 3; ++a) {
-    std::transform(differences.begin(), differences.end(), axis.begin(),
-                   [a](const Eigen::Vector3d& d) { return std::abs(d[a]); });
-    out[a] = median(axis) / kMedianAbsoluteOfNormal / std::sqrt(kSecondDifferenceVariance);
-  }
-  return out;
+  const Eigen::Vector3d median_abs =
+      axis_median(differences, [](const Eigen::Vector3d& d) -> Eigen::Vector3d { return d.cwiseAbs(); });
+  return median_abs / kMedianAbsoluteOfNormal / std::sqrt(kSecondDifferenceVariance);
 }
 
 /// The std of the mean of a step's samples: one sample's / sqrt(samples a step), never below one.
