@@ -10,7 +10,7 @@
 // estimate is the mean of the batches' variances over the last kMemoryBatches. Averaged over a
 // filter step of n samples the input's std is that / sqrt(n). Measured on the simulator's IMUs
 // (std over a 10 ms step): racetrack 0.007 rad/s and 0.18 m/s^2, urban 0.003 and 0.05, handheld
-// 0.0035 and 0.056; a vibrating race car's (3e-3 rad/s/sqrt(Hz), 7e-2 m/s^2/sqrt(Hz) at 800 Hz)
+// 0.0036 and 0.057; a vibrating race car's (3e-3 rad/s/sqrt(Hz), 7e-2 m/s^2/sqrt(Hz) at 800 Hz)
 // 0.030 and 0.70: its true values.
 #include <Eigen/Core>
 #include <cstddef>
