@@ -25,11 +25,10 @@ from farlio.simulation import LIDAR_MODELS, PROFILES, Recording, make_config, re
 from harness import FIXED_LATENCY_S, LIDAR_ONLY
 
 METRICS = ("ape_m", "rpe_pct", "rot_deg", "rot_origin_deg")
-DECIMALS = {"ape_m": 3, "rpe_pct": 3, "rot_deg": 3, "rot_origin_deg": 3}
 
 
-def cell(values: list[float], metric: str) -> str:
-    return " / ".join(f"{v:.{DECIMALS[metric]}f}" for v in values)
+def cell(values: list[float]) -> str:
+    return " / ".join(f"{v:.3f}" for v in values)
 
 
 def main() -> int:
@@ -59,7 +58,7 @@ def main() -> int:
             for metric in METRICS:
                 a, b = [r[metric] for r in lio], [r[metric] for r in lo]
                 worse = any(x > y for x, y in zip(a, b))
-                row += [f"**{cell(a, metric)}**" if worse else cell(a, metric), cell(b, metric)]
+                row += [f"**{cell(a)}**" if worse else cell(a), cell(b)]
             counts = [sum(int(r.get(k, 0) or 0) for r in lio) for k in ("failed", "reinit", "rejected")]
             started = ["yes" if "initialization" in r and r["initialization"].initialized else "no" for r in lio]
             row += [" / ".join(map(str, counts)), " / ".join(started)]

@@ -457,11 +457,16 @@ def _fusion_summary(stats: Any, config: Any) -> dict[str, Any]:
     }
 
 
+#: an IMU below this share of the filter's step rate is said to be slower than it (a 100 Hz IMU's
+#: measured rate scatters by a few tenths of a hertz about the step's)
+SLOWER_THAN_STEP_SHARE = 0.9
+
+
 def _imu_lines(imu: dict[str, float]) -> list[str]:
     """One line each where the IMU is slower than the filter's step or noisier than its defaults."""
     lines = []
     step_s = imu["step_s"]
-    if 0.0 < imu["rate_hz"] < 0.9 / step_s:
+    if 0.0 < imu["rate_hz"] < SLOWER_THAN_STEP_SHARE / step_s:
         lines.append(
             f"IMU at {imu['rate_hz']:.0f} Hz, slower than the filter's {1.0 / step_s:.0f} Hz step: its samples are "
             f"interpolated between the steps, and the {1.0 / step_s:.0f} Hz output follows the newest sample "
