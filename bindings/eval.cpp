@@ -54,7 +54,11 @@ void bind_options(nb::module_& m) {
   nb::enum_<AlignmentMethod>(m, "AlignmentMethod")
       .value("UMEYAMA", AlignmentMethod::kUmeyama)
       .value("UMEYAMA_ORIENTATION", AlignmentMethod::kUmeyamaOrientation)
-      .value("ORIENTATION", AlignmentMethod::kOrientation);
+      .value("ORIENTATION", AlignmentMethod::kOrientation)
+      .value("ORIGIN", AlignmentMethod::kOrigin);
+  nb::enum_<ApeAlignment>(m, "ApeAlignment", "How the APE aligns the estimate onto the ground truth")
+      .value("LEAST_SQUARES", ApeAlignment::kLeastSquares, "over every pair (evo_ape --align)")
+      .value("ORIGIN", ApeAlignment::kOrigin, "the first pair made one (evo_ape --align_origin)");
   nb::enum_<DeltaUnit>(m, "DeltaUnit").value("FRAMES", DeltaUnit::kFrames).value("METERS", DeltaUnit::kMeters);
 
   nb::class_<AssociationOptions>(m, "AssociationOptions")
@@ -78,6 +82,7 @@ void bind_options(nb::module_& m) {
       .def(nb::init<>())
       .def_rw("association", &EvalOptions::association)
       .def_rw("align_with_scale", &EvalOptions::align_with_scale)
+      .def_rw("ape_alignment", &EvalOptions::ape_alignment, "LEAST_SQUARES over every pair, or ORIGIN")
       .def_rw("min_spread_to_residual", &EvalOptions::min_spread_to_residual,
               "below this spread across an axis (in RMS residuals) the rotation about it comes from the orientations")
       .def_rw("kitti", &EvalOptions::kitti)

@@ -7,7 +7,7 @@ For each profile, LiDAR model and seed the generator records `--duration` second
 (`farlio simulate PROFILE --lidar L`, in memory), and the deterministic replay (fixed 20 ms latency)
 runs it with the IMU and with `fusion.enabled=false`. One markdown row per profile and LiDAR: the
 scan poses' APE (m, aligned RMSE), KITTI-style RPE (%), rotation RMSE (deg) after the APE's
-alignment and rotation RMSE from the first pose (deg, farlio.simulation.rotation_from_origin_deg) of
+alignment and rotation RMSE aligned at the first pose (deg, `farlio eval --align-origin`) of
 both modes, each
 cell the seeds separated by " / ", a metric in bold where the LIO is worse than LiDAR-only on some
 seed; then the LIO's registration failures, re-initialisations and rejected LiDAR groups, summed

@@ -31,6 +31,7 @@ def make_options(
     max_time_diff_s: float | None = None,
     nearest: bool = False,
     align_scale: bool = False,
+    align_origin: bool = False,
     kitti_step: int | None = None,
     segment_lengths_m: list[float] | None = None,
     rpe_delta: float | None = None,
@@ -47,7 +48,10 @@ def make_options(
         assoc.max_time_diff_s = max_time_diff_s
     assoc.mode = ev.AssociationMode.NEAREST if nearest else ev.AssociationMode.INTERPOLATE
     o.association = assoc
+    if align_scale and align_origin:
+        raise ValueError("an alignment at the origin has no scale: align_scale and align_origin exclude each other")
     o.align_with_scale = align_scale
+    o.ape_alignment = ev.ApeAlignment.ORIGIN if align_origin else ev.ApeAlignment.LEAST_SQUARES
     kitti = o.kitti
     if kitti_step is not None:
         kitti.step_frames = kitti_step
@@ -70,7 +74,8 @@ def make_options(
 
 def alignment_method_name(method) -> str:
     """'umeyama' (positions), 'umeyama_orientation' (positions on a line: the rotation about it from
-    the orientations) or 'orientation' (positions at one point), as eval.json states it."""
+    the orientations), 'orientation' (positions at one point) or 'origin' (the first poses made one),
+    as eval.json states it."""
     return method.name.lower()
 
 
@@ -215,7 +220,13 @@ def add_eval_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--scan-stamps", type=Path, help="file of scan stamps in seconds (coverage reference)")
     parser.add_argument("--max-time-diff", type=non_negative_float, default=0.01, help="association tolerance [s]")
     parser.add_argument("--nearest", action="store_true", help="nearest-stamp association (no interpolation)")
-    parser.add_argument("--align-scale", action="store_true", help="Sim(3) alignment for the aligned APE")
+    align = parser.add_mutually_exclusive_group()
+    align.add_argument("--align-scale", action="store_true", help="Sim(3) alignment for the aligned APE")
+    align.add_argument(
+        "--align-origin",
+        action="store_true",
+        help="align at the first pose instead of over every pose (evo's --align_origin): the drift from the start",
+    )
     parser.add_argument(
         "--kitti-step", type=positive_int, default=1, help="first frame every N frames (KITTI devkit: 10)"
     )
@@ -238,6 +249,7 @@ def run_eval(args: argparse.Namespace) -> int:
         max_time_diff_s=args.max_time_diff,
         nearest=args.nearest,
         align_scale=args.align_scale,
+        align_origin=args.align_origin,
         kitti_step=args.kitti_step,
         segment_lengths_m=args.segments,
         rpe_delta=args.rpe_delta,

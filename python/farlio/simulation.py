@@ -186,28 +186,12 @@ def replay(rec: Recording, overrides: list[str], *, fixed_latency_s: float = 0.0
     return run
 
 
-def rotation_from_origin_deg(scans: Any, gt_scans: list) -> float:
-    """RMS of the scan poses' rotation error relative to their first pose (deg; the trajectories
-    aligned at their first pose, as evo's --align_origin). Unlike the APE's rotation, after an
-    alignment of the positions, it sees a roll about a nearly straight path: how the map frame was
-    levelled."""
-    stamps = np.asarray(scans.stamps_ns)
-    poses = np.asarray(scans.matrices())
-    if len(stamps) == 0:
-        return math.nan
-    truth = {int(s): np.asarray(p.matrix())[:3, :3] for s, p in gt_scans}
-    if any(int(s) not in truth for s in stamps):
-        return math.nan
-    g0, e0 = truth[int(stamps[0])], poses[0][:3, :3]
-    cosines = [(np.trace((g0.T @ truth[int(s)]).T @ (e0.T @ m[:3, :3])) - 1.0) / 2.0 for s, m in zip(stamps, poses)]
-    angles = np.degrees(np.arccos(np.clip(cosines, -1.0, 1.0)))
-    return float(np.sqrt(np.mean(np.square(angles))))
-
-
 def stretch_accuracy(run: ReplayRun, from_s: float = 0.0, to_s: float = math.inf) -> dict:
     """A replay's accuracy over the stretch [from_s, to_s] of its recording (s after its start): APE
     (aligned RMSE, m), KITTI-style RPE (%) and rotation RMSE (deg) of the scan poses and their
-    rotation RMSE from the stretch's first pose (rotation_from_origin_deg), APE and RPE of
+    rotation RMSE with the trajectories aligned at the stretch's first pose (evo's --align_origin:
+    unlike the APE's rotation, after an alignment of the positions, it sees a roll about a nearly
+    straight path, that is how the map frame was levelled), APE and RPE of
     the 100 Hz odometry, the frames that failed or restarted the map there; for the whole run, the
     first fused output after the first scan (s), how the filter started and how far its estimate of
     up is from the truth in the map frame, then and at the end (deg)."""
@@ -223,7 +207,9 @@ def stretch_accuracy(run: ReplayRun, from_s: float = 0.0, to_s: float = math.inf
         "ape_m": r.ape.translation_m.rmse,
         "rpe_pct": r.kitti_rpe.translation_pct,
         "rot_deg": r.ape.rotation_deg.rmse,
-        "rot_origin_deg": rotation_from_origin_deg(stretch, run.rec.gt_scans),
+        "rot_origin_deg": _core.eval.evaluate(
+            stretch, run.rec.gt_scans, make_options(align_origin=True)
+        ).ape.rotation_deg.rmse,
     }
     inside = [f for f in run.frames if from_ns <= f[0] <= to_ns]
     out |= {"failed": sum(f[1] for f in inside), "map_restarts": sum(f[2] for f in inside)}
@@ -255,7 +241,6 @@ __all__ = [
     "generate",
     "make_config",
     "replay",
-    "rotation_from_origin_deg",
     "stretch_accuracy",
     "write_sequence",
     "farlio",

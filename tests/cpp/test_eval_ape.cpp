@@ -4,6 +4,7 @@
 #include <random>
 
 #include "eval_test_trajectories.hpp"
+#include "farlio/core/error.hpp"
 #include "farlio/eval/ape.hpp"
 
 using namespace farlio;
@@ -69,4 +70,48 @@ TEST(EvalApe, Sim3AlignmentRemovesScale) {
   const ApeResult r = compute_ape(scaled, gt, /*align_with_scale=*/true);
   EXPECT_NEAR(r.alignment.scale, 1.0 / kScale, 1e-9);
   EXPECT_LT(r.translation_m.max, 1e-8);
+}
+
+namespace {
+SE3 rotation_about(const Eigen::Vector3d& axis, double angle_rad) {
+  return SE3(Eigen::Quaterniond(Eigen::AngleAxisd(angle_rad, axis.normalized())), Eigen::Vector3d::Zero());
+}
+}  // namespace
+
+TEST(EvalApe, AtTheOriginAWholeTrajectoryRotatedHasNoError) {
+  // a frame turned as a whole (a map levelled 0.5 deg off, shifted): no drift from the start
+  const auto gt = test::poses_of(test::smooth_curve(300));
+  const SE3 frame = SE3(Eigen::Quaterniond::Identity(), Eigen::Vector3d(4.0, -2.0, 1.0)) *
+                    rotation_about(Eigen::Vector3d::UnitX(), 0.5 * M_PI / 180.0);
+  std::vector<SE3> turned;
+  for (const auto& p : gt) turned.push_back(frame * p);
+  const ApeResult r = compute_ape(turned, gt, false, kDefaultMinSpreadToResidual, ApeAlignment::kOrigin);
+  EXPECT_EQ(r.alignment.method, AlignmentMethod::kOrigin);
+  EXPECT_LT(r.translation_m.max, 1e-9);
+  EXPECT_LT(r.rotation_deg.max, 1e-6);
+}
+
+TEST(EvalApe, AtTheOriginAHeadingDriftGivesItsRmsAndAConstantRollAfterTheFirstPoseShows) {
+  const auto gt = test::poses_of(test::smooth_curve(21));
+  // each body 0.01 deg more in heading than the truth's, about its own z
+  constexpr double kRate_deg = 0.01;
+  std::vector<SE3> drifting, rolled;
+  for (std::size_t k = 0; k < gt.size(); ++k) {
+    drifting.push_back(gt[k] * rotation_about(Eigen::Vector3d::UnitZ(), kRate_deg * k * M_PI / 180.0));
+    rolled.push_back(k == 0 ? gt[k] : gt[k] * rotation_about(Eigen::Vector3d::UnitX(), 0.2 * M_PI / 180.0));
+  }
+  double sum = 0.0;
+  for (std::size_t k = 0; k < gt.size(); ++k) sum += std::pow(kRate_deg * k, 2);
+  const ApeResult d = compute_ape(drifting, gt, false, kDefaultMinSpreadToResidual, ApeAlignment::kOrigin);
+  EXPECT_NEAR(d.rotation_deg.rmse, std::sqrt(sum / gt.size()), 1e-7);
+  EXPECT_LT(d.translation_m.max, 1e-9);  // the bodies turned in place
+  // the same roll of every body after the first: sqrt(20 / 21) 0.2 deg
+  const ApeResult r = compute_ape(rolled, gt, false, kDefaultMinSpreadToResidual, ApeAlignment::kOrigin);
+  EXPECT_NEAR(r.rotation_deg.rmse, std::sqrt(20.0 / 21.0) * 0.2, 1e-7);
+}
+
+TEST(EvalApe, AnOriginAlignmentWithAScaleIsAnInputError) {
+  const auto gt = test::poses_of(test::smooth_curve(10));
+  EXPECT_THROW(compute_ape(gt, gt, /*align_with_scale=*/true, kDefaultMinSpreadToResidual, ApeAlignment::kOrigin),
+               InputError);
 }

@@ -137,6 +137,36 @@ def test_aligned_ape_matches_evo(files):
     assert ours["associated_poses"] == ref.num_poses
 
 
+def test_ape_aligned_at_the_origin_matches_evo(files, tmp_path):
+    """`farlio eval --align-origin` against evo's `align_origin`: the drift from the first pose."""
+    pytest.importorskip("evo")
+    from evo.core import metrics
+    from farlio import cli
+
+    ref, est = evo_pair(files)
+    est.align_origin(ref)
+    out = tmp_path / "origin"
+    assert (
+        cli.main(["eval", str(files["est"]), str(files["gt"]), "--out", str(out), "--align-origin", "--no-plot"]) == 0
+    )
+    ours = json.loads((out / "eval.json").read_text())["ape"]
+    assert ours["alignment"]["method"] == "origin"
+    for relation, key in (
+        (metrics.PoseRelation.translation_part, "translation_m"),
+        (metrics.PoseRelation.rotation_angle_deg, "rotation_deg"),
+    ):
+        ape = metrics.APE(relation)
+        ape.process_data((ref, est))
+        stats = ape.get_all_statistics()
+        for name in ("rmse", "mean", "median", "max"):
+            assert ours[key][name] == pytest.approx(stats[name], rel=REL_TOL, abs=1e-9), (key, name)
+    # the drift from the start exceeds the least-squares fit's error, which spreads it over the run
+    fitted = evaluation.evaluate_files(files["est"], files["gt"], plot=False)["ape"]
+    assert ours["translation_m"]["rmse"] > fitted["translation_m"]["rmse"]
+    with pytest.raises(SystemExit):
+        cli.main(["eval", str(files["est"]), str(files["gt"]), "--out", str(out), "--align-origin", "--align-scale"])
+
+
 @pytest.mark.parametrize(
     "delta,unit,all_pairs", [(1, "frames", False), (10, "frames", True), (5.0, "m", False), (20.0, "m", True)]
 )

@@ -150,4 +150,12 @@ Alignment align_poses(std::span<const SE3> source, std::span<const SE3> target, 
   return a;
 }
 
+Alignment align_origin(std::span<const SE3> source, std::span<const SE3> target) {
+  check_sizes("align_origin", source.size(), target.size());
+  Alignment a;
+  a.transform = target.front() * source.front().inverse();
+  a.method = AlignmentMethod::kOrigin;
+  return a;
+}
+
 }  // namespace farlio::eval

@@ -5,6 +5,10 @@
 //   align_poses: Umeyama on the positions of two pose sequences, except where the positions do not
 //     determine the rotation (all on a line, or all at one point): the rotation the positions leave
 //     free is then the one that best aligns the source orientations with the target ones.
+//   align_origin: the rigid transform that makes the first source pose the first target pose
+//     (evo's --align_origin): the errors are then the drift from the start, so that a trajectory
+//     rotated as a whole (a map frame levelled a little off) has none, while a roll about a straight
+//     path, which a least-squares fit of the positions leaves in the orientations, shows.
 #include <Eigen/Core>
 #include <span>
 
@@ -17,6 +21,7 @@ enum class AlignmentMethod {
   kUmeyama,             ///< from the positions alone
   kUmeyamaOrientation,  ///< positions on a line: Umeyama, then the rotation about the line from the orientations
   kOrientation,         ///< positions at one point: the rotation from the orientations alone
+  kOrigin,              ///< the first poses made one (align_origin)
 };
 
 /// Positions fix the rotation about an axis only when they spread across it: the spread (the square
@@ -56,5 +61,8 @@ Alignment umeyama_align(std::span<const Eigen::Vector3d> source, std::span<const
 /// translation then takes the source centroid onto the target centroid.
 Alignment align_poses(std::span<const SE3> source, std::span<const SE3> target, bool with_scale = false,
                       double min_spread_to_residual = kDefaultMinSpreadToResidual);
+
+/// The transform target[0] source[0]^-1 (method kOrigin, scale 1); the sequences as align_poses.
+Alignment align_origin(std::span<const SE3> source, std::span<const SE3> target);
 
 }  // namespace farlio::eval

@@ -27,15 +27,20 @@ PerPairErrors pair_errors(std::span<const SE3> estimate, std::span<const SE3> gr
 }  // namespace
 
 ApeResult compute_ape(std::span<const SE3> estimate, std::span<const SE3> groundtruth, bool align_with_scale,
-                      double min_spread_to_residual) {
+                      double min_spread_to_residual, ApeAlignment alignment) {
   if (estimate.size() != groundtruth.size()) {
     throw InputError("compute_ape: " + std::to_string(estimate.size()) + " estimate poses but " +
                      std::to_string(groundtruth.size()) + " ground-truth poses");
   }
+  if (align_with_scale && alignment == ApeAlignment::kOrigin) {
+    throw InputError("compute_ape: an alignment at the origin has no scale (align_with_scale and kOrigin)");
+  }
   ApeResult r;
   if (estimate.empty()) return r;
 
-  r.alignment = align_poses(estimate, groundtruth, align_with_scale, min_spread_to_residual);
+  r.alignment = alignment == ApeAlignment::kOrigin
+                    ? align_origin(estimate, groundtruth)
+                    : align_poses(estimate, groundtruth, align_with_scale, min_spread_to_residual);
   r.aligned_estimate.reserve(estimate.size());
   for (const SE3& pose : estimate) r.aligned_estimate.push_back(r.alignment.apply(pose));
 

@@ -26,7 +26,8 @@ EvaluationResult evaluate(const Trajectory& estimate, const Trajectory& groundtr
 
   const std::vector<double> dist = cumulative_path_length_m(pairs.groundtruth);
   r.groundtruth_path_length_m = dist.back();
-  r.ape = compute_ape(pairs.estimate, pairs.groundtruth, options.align_with_scale, options.min_spread_to_residual);
+  r.ape = compute_ape(pairs.estimate, pairs.groundtruth, options.align_with_scale, options.min_spread_to_residual,
+                      options.ape_alignment);
   r.kitti_rpe = compute_kitti_rpe(pairs.estimate, pairs.groundtruth, options.kitti);
   r.rpe = compute_delta_rpe(pairs.estimate, pairs.groundtruth, options.rpe);
   r.stamps_ns = std::move(pairs.stamps_ns);

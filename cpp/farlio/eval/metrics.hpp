@@ -18,7 +18,8 @@ inline constexpr std::size_t kMinAssociatedPoses = 3;
 
 struct EvalOptions {
   AssociationOptions association;
-  bool align_with_scale = false;  ///< Sim(3) instead of SE(3) alignment for the aligned APE
+  bool align_with_scale = false;                             ///< Sim(3) instead of SE(3) alignment for the aligned APE
+  ApeAlignment ape_alignment = ApeAlignment::kLeastSquares;  ///< every pair, or the first (ape.hpp)
   /// below this spread of the positions across an axis, in RMS residuals of the position fit, the
   /// rotation about it is taken from the orientations (align_poses)
   double min_spread_to_residual = kDefaultMinSpreadToResidual;
