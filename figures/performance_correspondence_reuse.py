@@ -1,5 +1,5 @@
 """Accuracy and registration time against registration.correspondence_reuse_m (docs/performance.md,
-"What makes each stage fast", item 6).
+"Registration (GICP)": correspondences kept over Gauss-Newton iterations).
 
 LiDAR-only scan pipeline (ScanPipeline) over the same scans for each reuse distance: generated
 profiles (80 scans, with ground truth: APE and KITTI-style RPE) and recordings (no ground truth:

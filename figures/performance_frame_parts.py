@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""What parts of a frame cost, by switching them off or on in turns (docs/performance.md, "What makes each stage
-fast", items 8-9):
+"""What parts of a frame cost, by switching them off or on in turns (docs/performance.md, "Preprocessing" and
+"Registration (GICP)": keys and deduplication in one loop, coarse to fine):
 the LiDAR-only scan pipeline runs over the same scans once per variant and round, the variants
 alternating so that all see the same machine load. Per data set and variant it prints the median
 and p99 of the whole frame, the stage medians, and the registration time of the second frame

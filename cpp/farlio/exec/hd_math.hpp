@@ -31,7 +31,7 @@ FARLIO_HD bool all_finite(const Derived& m) {
 /// floor(x) as an int for |x| < 2^31 (beyond, as undefined as static_cast<int>(floorf(x))). On
 /// the host the truncation toward zero is corrected by one below zero: x86-64's baseline (SSE2)
 /// has no float floor instruction, and floorf's emulation took a tenth of the preprocessing
-/// (docs/performance.md, item 11). The same integer as floorf over that range.
+/// (docs/performance.md, "Voxel keys without floorf's emulation"). The same integer as floorf over that range.
 FARLIO_HD inline int floor_to_int(float x) {
 #ifdef FARLIO_ON_DEVICE
   return static_cast<int>(floorf(x));

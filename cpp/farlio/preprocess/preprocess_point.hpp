@@ -33,7 +33,7 @@ FARLIO_HD inline bool finite_point(const Eigen::Vector3f& raw, const float* time
 /// out-of-range point. The cells are those of the raw positions: only the point kept in each cell
 /// is then undistorted (undistorted_point), ~10k points instead of the scan's ~120k. A cell's
 /// neighbours in the scan were measured microseconds apart, so the distortion shifts them alike
-/// and the kept points keep the map spacing (docs/performance.md, item 10).
+/// and the kept points keep the map spacing (docs/performance.md, "Only the kept points are undistorted").
 FARLIO_HD inline std::uint64_t downsampling_key(const Eigen::Vector3f& raw, const PreprocessParams& pp) {
   return pp.crop.keeps(raw) ? map::point_key(raw, pp.inv_cell_m) : map::kEmptyKey;
 }
