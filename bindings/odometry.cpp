@@ -96,6 +96,16 @@ void bind_fusion_stats(nb::module_& m) {
               "| |g| estimated freely - g | / g over the window: how consistent its data were")
       .def("__repr__", attribute_repr({"mode", "stamp_ns", "window_poses", "window_s", "speed_m_s", "map_tilt_deg",
                                        "gravity_norm_error"}));
+  nb::class_<fusion::InnovationStats>(m, "InnovationStats",
+                                      "The normalised innovations (NIS) of a LiDAR group (fusion/innovation_stats.hpp)")
+      .def_ro("group", &fusion::InnovationStats::group, "the measurement group: pose, position, orientation, velocity")
+      .def_ro("dim", &fusion::InnovationStats::dim, "its degrees of freedom")
+      .def_ro("count", &fusion::InnovationStats::count, "groups checked (accepted or gated)")
+      .def_prop_ro("mean_per_dof", &fusion::InnovationStats::mean_per_dof,
+                   "mean NIS per degree of freedom: 1 when the filter's noise fits the data")
+      .def_prop_ro("share_beyond_95", &fusion::InnovationStats::share_beyond_95,
+                   "share of groups beyond the chi-squared 95 % quantile: 0.05 when it fits")
+      .def("__repr__", attribute_repr({"group", "dim", "count", "mean_per_dof", "share_beyond_95"}));
   nb::class_<fusion::FusionStats>(m, "FusionStats")
       .def_ro("steps", &fusion::FusionStats::steps)
       .def_ro("lidar_groups_accepted", &fusion::FusionStats::lidar_groups_accepted)
@@ -118,6 +128,8 @@ void bind_fusion_stats(nb::module_& m) {
       .def_ro("measured_accel_step_std_m_s2", &fusion::FusionStats::measured_accel_step_std_m_s2,
               "the accelerometer's noise measured on its samples, averaged over a filter step")
       .def_ro("imu_rate_hz", &fusion::FusionStats::imu_rate_hz, "the IMU's sample rate (0 before the first estimate)")
+      .def_ro("lidar_innovation", &fusion::FusionStats::lidar_innovation,
+              "the LiDAR groups' normalised innovations, one InnovationStats per group fused")
       .def("__repr__", attribute_repr({"steps", "lidar_groups_accepted", "lidar_groups_rejected", "reinitializations",
                                        "imu_gaps", "imu_samples_dropped", "imu_samples_rejected", "accel_in_g",
                                        "gyro_bias_rad_s", "last_warning"}));

@@ -28,21 +28,29 @@ from harness import FIXED_LATENCY_S, LIDAR_ONLY
 RACING_GYRO_DENSITY, RACING_ACCEL_DENSITY = 3e-3, 7e-2
 
 
-def recording(profile: str, seed: int, duration_s: float, imu: str, grade: str = "profile") -> Recording:
-    """The profile's recording with the IMU `imu` (see the module's docstring) of `grade`."""
+def racing_noise(profile: str) -> dict[str, float]:
+    """make_config's noise fields of the race car's IMU at the profile's IMU rate."""
+    rate = make_config(profile).imu_rate_hz
+    return {
+        "gyro_noise_std_rad_s": RACING_GYRO_DENSITY * math.sqrt(rate),
+        "accel_noise_std_m_s2": RACING_ACCEL_DENSITY * math.sqrt(rate),
+    }
+
+
+def recording(
+    profile: str, seed: int, duration_s: float, imu: str, grade: str = "profile", lidar: str = "profile"
+) -> Recording:
+    """The profile's recording with the IMU `imu` (see the module's docstring) of `grade`, and the
+    LiDAR model `lidar`."""
     kind, _, rest = imu.partition(":")
+    base = {"seed": seed, "duration_s": duration_s, "lidar": lidar}
     if kind in ("profile", "drop", "gap"):
-        rec = Recording(make_config(profile, seed=seed, duration_s=duration_s, imu_grade=grade))
+        rec = Recording(make_config(profile, imu_grade=grade, **base))
     elif kind == "racing":
-        rate = make_config(profile).imu_rate_hz
-        noise = {"gyro_noise_std_rad_s": RACING_GYRO_DENSITY * math.sqrt(rate)}
-        noise["accel_noise_std_m_s2"] = RACING_ACCEL_DENSITY * math.sqrt(rate)
-        rec = Recording(make_config(profile, seed=seed, duration_s=duration_s, **noise))
+        rec = Recording(make_config(profile, **base, **racing_noise(profile)))
     else:
         offset = float(rest or 0.0)
-        rec = Recording(
-            make_config(profile, seed=seed, duration_s=duration_s, imu_rate_hz=float(kind), imu_time_offset_s=offset)
-        )
+        rec = Recording(make_config(profile, imu_rate_hz=float(kind), imu_time_offset_s=offset, **base))
     if kind == "drop":
         every = int(rest)
         rec.imu = [s for i, s in enumerate(rec.imu) if i % every != every - 1]

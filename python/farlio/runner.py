@@ -454,6 +454,17 @@ def _fusion_summary(stats: Any, config: Any) -> dict[str, Any]:
             "gyro_input_std_rad_s": config.get("fusion.gyro_input_std_rad_s"),
             "accel_input_std_m_s2": config.get("fusion.accel_input_std_m_s2"),
         },
+        # the LiDAR updates' normalised innovations squared (NIS) per degree of freedom: 1 and 5 %
+        # beyond the chi-squared 95 % quantile when the filter's noise fits the data
+        "innovation": {
+            s.group: {
+                "dof": s.dim,
+                "count": s.count,
+                "mean_nis_per_dof": s.mean_per_dof,
+                "share_beyond_95": s.share_beyond_95,
+            }
+            for s in stats.lidar_innovation
+        },
     }
 
 

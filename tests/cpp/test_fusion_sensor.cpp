@@ -2,6 +2,10 @@
 // noisy IMU and LiDAR, outlier rejection, delay compensation, upsampling smoothness, IMU gaps.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <random>
+#include <string>
+
 #include "fusion_test_sim.hpp"
 
 using namespace farlio;
@@ -267,4 +271,52 @@ TEST(FusionSensor, PoseAtAPastStampCarriesTheCorrectionsFusedSince) {
   EXPECT_GT(moved_a.dot(offset.normalized()), 0.05);  // towards the result
   EXPECT_LT(moved_a.norm(), offset.norm() + 0.01);    // not beyond it
   EXPECT_LT((moved_a - moved_b).norm(), 1e-6);        // the same shift for both: no injection between
+}
+
+TEST(FusionSensor, InnovationStatisticsTellAMatchedLidarNoiseFromAnOverconfidentOne) {
+  // the LiDAR's noise as configured: NIS per degree of freedom near 1, 5 % beyond the 95 % quantile;
+  // the LiDAR's stds claimed 10x too small: far above both
+  const SimResult matched = simulate(slow_curve(), matched_config(), noisy_options(10.0));
+  ASSERT_TRUE(matched.finite);
+  FusionConfig overconfident = matched_config();
+  overconfident.lidar_position_std_m /= 10.0;
+  overconfident.lidar_roll_pitch_std_rad /= 10.0;
+  overconfident.lidar_yaw_std_rad /= 10.0;
+  const SimResult over = simulate(slow_curve(), overconfident, noisy_options(10.0));
+  for (const std::string group : {"position", "orientation"}) {
+    const auto find = [&](const fusion::FusionStats& s) {
+      const auto it = std::find_if(s.lidar_innovation.begin(), s.lidar_innovation.end(),
+                                   [&](const fusion::InnovationStats& i) { return i.group == group; });
+      return it == s.lidar_innovation.end() ? fusion::InnovationStats{} : *it;
+    };
+    const fusion::InnovationStats m = find(matched.stats), o = find(over.stats);
+    EXPECT_EQ(m.dim, 3) << group;
+    EXPECT_GE(m.count, 95) << group;  // 10 Hz over 10 s, the first result initialises
+    EXPECT_GT(m.mean_per_dof(), 0.6) << group;
+    EXPECT_LT(m.mean_per_dof(), 1.4) << group;
+    EXPECT_LT(m.share_beyond_95(), 0.1) << group;
+    EXPECT_GT(o.mean_per_dof(), 5.0) << group;
+    EXPECT_GT(o.share_beyond_95(), 0.5) << group;
+    std::printf("%s NIS per dof: matched %.2f (%.0f %% beyond the 95 %% quantile), 10x overconfident %.2f (%.0f %%)\n",
+                group.c_str(), m.mean_per_dof(), 100.0 * m.share_beyond_95(), o.mean_per_dof(),
+                100.0 * o.share_beyond_95());
+  }
+}
+
+TEST(FusionSensor, ChiSquaredQuantilesHoldForGaussianInnovations) {
+  // innovations drawn from their own covariance: mean NIS per dof 1, 5 % beyond the 95 % quantile
+  std::mt19937 rng(7);
+  std::normal_distribution<double> normal;
+  for (int dim = 1; dim <= 6; ++dim) {
+    fusion::InnovationStats s{.group = "test", .dim = dim};
+    for (int k = 0; k < 200000; ++k) {
+      double nis = 0.0;
+      for (int i = 0; i < dim; ++i) nis += std::pow(normal(rng), 2);
+      s.add(nis);
+    }
+    EXPECT_NEAR(s.mean_per_dof(), 1.0, 0.01) << dim;
+    EXPECT_NEAR(s.share_beyond_95(), 0.05, 0.002) << dim;
+  }
+  EXPECT_EQ(fusion::chi2_95(0), 0.0);
+  EXPECT_EQ(fusion::chi2_95(7), 0.0);
 }

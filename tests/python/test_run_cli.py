@@ -66,6 +66,11 @@ def test_demo_runs_on_a_generated_sequence_without_writing_its_scans(tmp_path):
     summary = json.loads((out / "summary.json").read_text())
     assert summary["processed"] == summary["frames"] == 80
     assert summary["fusion"]["initialization"]["mode"] == "standstill"
+    # every LiDAR result after the one that started the filter is checked against the prediction
+    innovation = summary["fusion"]["innovation"]
+    assert set(innovation) == {"pose", "velocity"}
+    assert innovation["pose"]["dof"] == 6 and innovation["pose"]["count"] >= 75
+    assert 0.0 < innovation["pose"]["mean_nis_per_dof"] < 1.0 and innovation["pose"]["share_beyond_95"] <= 0.05
     assert summary["accuracy"]["ape"]["translation_m"]["rmse"] < 0.03
     assert summary["accuracy_odometry"]["ape"]["translation_m"]["rmse"] < 0.03
     size = sum(f.stat().st_size for f in out.rglob("*") if f.is_file())

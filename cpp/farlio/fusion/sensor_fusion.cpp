@@ -105,6 +105,14 @@ void SensorFusion::record_correction(const StateVector& before) {
   cumulative_correction_ += d;
 }
 
+void SensorFusion::record_innovation(MeasurementKind kind, int dim, double nis) {
+  const std::string group = kind_name(kind);
+  auto& all = stats_.lidar_innovation;
+  auto it = std::find_if(all.begin(), all.end(), [&](const InnovationStats& s) { return s.group == group; });
+  if (it == all.end()) it = all.insert(all.end(), InnovationStats{.group = group, .dim = dim});
+  it->add(nis);
+}
+
 double SensorFusion::gate(int dim) const {
   if (!config_.outlier_rejection) return 0.0;
   if (dim == 2) return config_.outlier_chi2_2dof;
@@ -402,7 +410,9 @@ LidarUpdateResult SensorFusion::add_lidar(std::int64_t measured_at_ns, const SE3
   for (std::size_t i = 0; i < groups.size(); ++i) {
     const LidarGroup& g = groups[i];
     const double limit = gate(static_cast<int>(g.z.size()));
-    const bool accepted = limit <= 0.0 || ekf_.mahalanobis_squared(g.kind, residuals[i], g.R) <= limit;
+    const double nis = ekf_.mahalanobis_squared(g.kind, residuals[i], g.R);
+    const bool accepted = limit <= 0.0 || nis <= limit;
+    record_innovation(g.kind, static_cast<int>(g.z.size()), nis);
     if (accepted) {
       queue_.add(g.kind, g.z, residuals[i], g.R, injections);
       ++stats_.lidar_groups_accepted;

@@ -25,6 +25,7 @@
 #include "farlio/fusion/imu_gate.hpp"
 #include "farlio/fusion/imu_noise.hpp"
 #include "farlio/fusion/initialization.hpp"
+#include "farlio/fusion/innovation_stats.hpp"
 #include "farlio/fusion/kinematic_ekf.hpp"
 #include "farlio/fusion/reference_angles.hpp"
 #include "farlio/fusion/standstill_bias.hpp"
@@ -65,6 +66,10 @@ struct FusionStats {
   double measured_gyro_step_std_rad_s = 0.0;
   double measured_accel_step_std_m_s2 = 0.0;
   double imu_rate_hz = 0.0;
+  /// The LiDAR updates' normalised innovations (innovation_stats.hpp), one entry per group fused:
+  /// the pose (with the registration's covariance) or the position and orientation (the fixed
+  /// noise), and the velocity.
+  std::vector<InnovationStats> lidar_innovation;
 };
 
 /// Which groups of one LiDAR result were accepted.
@@ -160,6 +165,8 @@ class SensorFusion {
   void fuse_reference_angles(std::int64_t stamp_ns);
   [[nodiscard]] int spread_steps(std::int64_t measured_at_ns) const;
   [[nodiscard]] double gate(int dim) const;
+  /// Adds a LiDAR group's NIS to its InnovationStats.
+  void record_innovation(MeasurementKind kind, int dim, double nis);
   void warn(std::string message);
   /// Adds x_after - x_before (angles wrapped) to the cumulative correction.
   void record_correction(const StateVector& before);
