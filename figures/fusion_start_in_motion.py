@@ -25,6 +25,7 @@ import math
 import sys
 
 from farlio.simulation import LIDAR_MODELS, PROFILES, Recording, make_config, replay, stretch_accuracy
+from fusion_imu_rates import racing_noise
 from harness import FIXED_LATENCY_S, mode_overrides
 
 COLUMNS = ["ape_m", "rpe_pct", "rot_deg", "odom_ape_m", "odom_rpe_pct", "failed", "map_restarts", "reinit"]
@@ -55,6 +56,9 @@ def main() -> int:
     p.add_argument("--duration", type=float, required=True, help="seconds recorded from there")
     p.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
     p.add_argument("--imu-grade", default="profile")
+    p.add_argument(
+        "--racing-imu", action="store_true", help="the race car's IMU noise (figures/fusion_imu_rates.py's racing)"
+    )
     p.add_argument("--lidar", choices=LIDAR_MODELS, default="profile", help="the LiDAR model (farlio simulate --lidar)")
     p.add_argument("--no-reference", action="store_true", help="without the run started at rest")
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="NAME=VALUE")
@@ -63,6 +67,7 @@ def main() -> int:
         f"{args.profile} ({args.lidar} LiDAR), {args.duration:g} s from {args.start:g} s into the motion; "
         f"columns: {' '.join(COLUMNS)}"
     )
+    noise = racing_noise(args.profile) if args.racing_imu else {}
     for seed in args.seeds:
         cut = Recording(
             make_config(
@@ -72,6 +77,7 @@ def main() -> int:
                 motion_start_s=args.start,
                 imu_grade=args.imu_grade,
                 lidar=args.lidar,
+                **noise,
             )
         )
         runs = {
@@ -88,6 +94,7 @@ def main() -> int:
                     duration_s=args.start + args.duration,
                     imu_grade=args.imu_grade,
                     lidar=args.lidar,
+                    **noise,
                 )
             )
             ref_run = replay(whole, mode_overrides(args.overrides), fixed_latency_s=FIXED_LATENCY_S)
