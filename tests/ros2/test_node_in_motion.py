@@ -66,6 +66,10 @@ def expect_initialised_in_motion(recorder, n: int) -> None:
     assert "in motion" in modes, modes
     # within 1 s of the first scan (10 Hz: the first 10 scans' diagnostics)
     assert modes.index("in motion") < 10, modes
+    # the LiDAR poses' innovations once fused: far below 1 per dof on this urban drive (by design:
+    # docs/fusion.md, "Innovation statistics")
+    nis = float(diags[-1]["fusion_pose_nis_per_dof"])
+    assert 0.0 < nis < 0.2, nis
 
 
 def test_node_started_in_motion_initialises_in_motion(moving, recorder, start_node, tmp_path):

@@ -58,6 +58,12 @@ ODOMETRY_DEPTH, CLOUD_DEPTH, DIAGNOSTICS_DEPTH = 100, 2, 20
 MAP_SUFFIXES = {".ply": _core.io.write_ply, ".pcd": _core.io.write_pcd}
 
 
+def _pose_nis(stats: Any) -> float | str:
+    """The pose group's mean NIS per degree of freedom so far ('' before the first, or LiDAR-only)."""
+    pose = [g for g in stats.lidar_innovation if g.group == "pose"] if stats is not None else []
+    return pose[0].mean_per_dof if pose else ""
+
+
 class FarlioNode(Node):
     def __init__(self, **kwargs: Any):
         super().__init__(NODE_NAME, **kwargs)
@@ -284,6 +290,9 @@ class FarlioNode(Node):
             "scans_dropped_busy": self.live.odometry.scans_dropped_busy,
             # how the filter started (at rest or in motion), '' before
             "fusion_initialization": stats.initialization.mode if stats is not None else "",
+            # the LiDAR poses' mean normalised innovation squared per dof so far ('' before the
+            # first): 1 when the filter's noise fits the data (docs/fusion.md, "Innovation statistics")
+            "fusion_pose_nis_per_dof": _pose_nis(stats),
             **self.live.stats.as_dict(),
         }
         if self.loops is not None:
