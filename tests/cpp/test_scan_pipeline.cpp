@@ -245,3 +245,41 @@ TEST(ScanPipeline, PersistentFailuresRestartTheMapAndTrackingResumes) {
   EXPECT_TRUE(next.failure.empty()) << next.failure;
   EXPECT_FALSE(next.map_restarted);
 }
+
+// A scan that sees more new space than mapped space (most of its points where the map has nothing:
+// a narrow field of view turning into a room) fails registration.min_inlier_fraction from the
+// constant-velocity guess, where it could as well be a scan of something else; from the fusion's
+// guess the registration stands (the fusion's gate judges it) and the map grows by the new space.
+TEST(ScanPipeline, FromTheFusionsGuessAScanOfMostlyNewSpaceIsNoFailure) {
+  const double period = 0.1;
+  for (const bool from_fusion : {false, true}) {
+    Config cfg;
+    cfg.num_threads = 2;
+    cfg.registration.time_budget_factor = 1e6;
+    pipeline::ScanPipeline p(cfg, truth_at(period));
+    for (int k = 0; k < 4; ++k) p.process(make_scan(k, period));
+    const std::size_t voxels_before = p.backend().map_voxels();
+    // the scene's scan and a ceiling 30 m above the sensor, 80 m by 80 m, that the map has never
+    // seen (the scene is 8 m high)
+    Scan scan = make_scan(4, period);
+    constexpr float kStep_m = 0.25f;
+    for (float x = -40.0f; x <= 40.0f; x += kStep_m) {
+      for (float y = -40.0f; y <= 40.0f; y += kStep_m) {
+        scan.points.emplace_back(x, y, 30.0f);
+        if (scan.has_time()) scan.time_s.push_back(static_cast<float>(period / 2));
+      }
+    }
+    const SE3 truth = truth_at(5 * period);
+    const auto r = p.process(scan, truth, std::nullopt, from_fusion, true);
+    ASSERT_TRUE(r.registered);
+    EXPECT_LT(r.inlier_fraction, cfg.registration.min_inlier_fraction) << "the scan must see mostly new space";
+    if (from_fusion) {
+      EXPECT_TRUE(r.failure.empty()) << r.failure;
+      EXPECT_LT(translation_error_m(r.pose, truth), 0.03);
+      EXPECT_GT(p.backend().map_voxels(), voxels_before + 300);  // the ceiling's cells
+    } else {
+      EXPECT_NE(r.failure.find("registration.min_inlier_fraction"), std::string::npos) << r.failure;
+      EXPECT_EQ(p.backend().map_voxels(), voxels_before);
+    }
+  }
+}

@@ -171,7 +171,7 @@ inline constexpr double kMaxThreads = 1024.0;
         "neither the map, the adaptive threshold nor the fusion")                                                 \
   FIELD(double, min_inlier_fraction, 0.5, range::fraction(),                                                      \
         "a registration matching fewer of the source points has failed (a scan of something else: a bogus "       \
-        "scan, a sensor fault)")                                                                                  \
+        "scan, a sensor fault), unless it stayed within the kernel scale of the fusion's guess (new space)")      \
   FIELD(double, map_restart_after_s, 1.0, range::positive_up_to_or_inf(kMaxSiValue),                              \
         "after failed registrations for this long, the map restarts from the current scan at the prediction")
 

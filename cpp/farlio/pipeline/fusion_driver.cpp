@@ -285,8 +285,11 @@ ScanPrior FusionDriver::prior(const Scan& scan, const registration::Vec6d& lidar
   if (!fusion_) return prior;
   if (fusion_->initialized()) {
     // while the gyro's unit is undecided, a scan during which it turns is registered by the LiDAR
-    // alone: a deg/s gyro would turn the guess 57 times too far (and the registration would follow)
-    if (gyro_unit_.turning(scan.start_stamp_ns, scan.end_stamp_ns)) return prior;
+    // alone (a deg/s gyro would turn the guess 57 times too far, and the registration would
+    // follow), unless the gyro turned as the LiDAR did in the last turn they both made (a narrow
+    // field of view facing a wall as the body looks around: its scans do not constrain every
+    // direction, the unit is not judged on them, and the LiDAR alone slides along the wall)
+    if (gyro_unit_.turning(scan.start_stamp_ns, scan.end_stamp_ns) && !gyro_turn_confirmed_) return prior;
     if (const auto body = fusion_->pose_at(scan.end_stamp_ns)) {
       prior.guess = *body * T_imu_lidar_;
       prior.motion = motion_from_fusion(*fusion_, scan, *prior.guess, T_imu_lidar_);
@@ -352,13 +355,14 @@ SE3 FusionDriver::measured_body_pose(const OdometryFrame& frame) const {
 void FusionDriver::compare_gyro_unit(std::int64_t stamp_ns, const OdometryFrame& frame) {
   // the gyro's unit is judged against scans that constrain every direction: the rotations of a
   // degenerate scan (a narrow field of view sliding along the track) carry errors that add up to a
-  // turn the gyro did not make
+  // turn the gyro did not make. Whether the gyro may turn a turning scan's guess is judged on every
+  // scan (compare_gyro_turn): a degenerate one still tells a turn from one 57 times as far.
   const bool constrained = !frame.degeneracy || !frame.degeneracy->degenerate();
   if (!frame.drop_reason.empty() || !fusion_ || !has_imu() || gyro_unit_.decided() || !last_body_ ||
-      stamp_ns <= last_body_->stamp_ns || !constrained || beyond_bridged_gap(stamp_ns))
+      stamp_ns <= last_body_->stamp_ns || beyond_bridged_gap(stamp_ns))
     return;
-  pending_rotations_.push_back(
-      {last_body_->stamp_ns, stamp_ns, so3_log((last_body_->pose.inverse() * frame.body_pose).rotation())});
+  pending_rotations_.push_back({last_body_->stamp_ns, stamp_ns,
+                                so3_log((last_body_->pose.inverse() * frame.body_pose).rotation()), constrained});
   compare_covered_rotations();
 }
 
@@ -370,14 +374,30 @@ void FusionDriver::compare_covered_rotations() {
     const PendingRotation r = pending_rotations_.front();
     pending_rotations_.pop_front();
     const auto gyro_rotation = fusion_->imu_rotation(r.start_ns, r.end_ns);
-    gyro_follows_lidar_ =
-        gyro_rotation && so3_log(*gyro_rotation).norm() <=
-                             kRotationAgreementRatio * r.lidar_rotation.norm() + kRotationAgreementFloor_rad;
+    compare_gyro_turn(gyro_rotation, r.lidar_rotation, r.constrained);
+    if (!r.constrained) continue;
     gyro_unit_.add_lidar_rotation(r.start_ns, r.end_ns, r.lidar_rotation);
     if (gyro_unit_.decided()) apply_gyro_unit();
     warn_undecided_gyro(r.end_ns);
   }
   if (gyro_unit_.decided()) pending_rotations_.clear();
+}
+
+void FusionDriver::compare_gyro_turn(const std::optional<Eigen::Matrix3d>& gyro_rotation,
+                                     const Eigen::Vector3d& lidar_rotation, bool constrained) {
+  // a gyro that turned more than 7.6 times as far as the LiDAR (give or take the floor) does not
+  // follow it. gyro_follows_lidar_ (the guess before the filter) is judged on scans that constrain
+  // every direction and holds on rotations within the floor; gyro_turn_confirmed_ (the filter's
+  // guess of a turning scan) on every scan, and only a turn of the LiDAR by the floor or more
+  // confirms it: a deg/s gyro reads 57 times a turn that small within the floor too
+  const double gyro_rad = gyro_rotation ? so3_log(*gyro_rotation).norm() : 0.0;
+  const bool within =
+      gyro_rotation && gyro_rad <= kRotationAgreementRatio * lidar_rotation.norm() + kRotationAgreementFloor_rad;
+  if (constrained) gyro_follows_lidar_ = within;
+  if (!within)
+    gyro_turn_confirmed_ = false;
+  else if (lidar_rotation.norm() >= kRotationAgreementFloor_rad)
+    gyro_turn_confirmed_ = true;
 }
 
 void FusionDriver::warn_undecided_gyro(std::int64_t stamp_ns) {

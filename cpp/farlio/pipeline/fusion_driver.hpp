@@ -156,6 +156,10 @@ class FusionDriver {
   void jump_clock(const ImuSample& sample);
   /// After the gyro unit was decided: scales and restarts, or ends the fusion.
   void apply_gyro_unit();
+  /// gyro_follows_lidar_ and gyro_turn_confirmed_ from one interval's rotations (gyro: nullopt
+  /// where the IMU does not cover it; constrained: the later scan constrains every direction).
+  void compare_gyro_turn(const std::optional<Eigen::Matrix3d>& gyro_rotation, const Eigen::Vector3d& lidar_rotation,
+                         bool constrained);
   /// Whether the registration held the frame's degenerate directions at the fusion's prior.
   [[nodiscard]] bool held_at_prior(const OdometryFrame& frame) const;
   /// The registration's pose covariance in the body frame (its degenerate rotation axes released
@@ -203,7 +207,8 @@ class FusionDriver {
   std::optional<ImuSample> held_jump_;             ///< a sample beyond the bridged gap, until the next one
   bool warned_no_imu_ = false;                     ///< a scan came before the first IMU sample
   std::optional<std::int64_t> first_compared_ns_;  ///< the first scan the gyro's unit was compared at
-  bool gyro_follows_lidar_ = false;                ///< the gyro turned as the LiDAR between the last two scans
+  bool gyro_follows_lidar_ = false;                ///< the gyro turned as the LiDAR between the last two scans compared
+  bool gyro_turn_confirmed_ = false;               ///< ... in the last interval in which either turned beyond the floor
   bool warned_undecided_gyro_ = false;
   std::optional<std::int64_t> first_degenerate_start_ns_;  ///< the first degenerate scan before the filter
   bool warned_degenerate_start_ = false;
@@ -217,6 +222,7 @@ class FusionDriver {
     std::int64_t start_ns = 0;
     std::int64_t end_ns = 0;
     Eigen::Vector3d lidar_rotation = Eigen::Vector3d::Zero();
+    bool constrained = true;  ///< the later scan constrains every direction: the unit is judged on it
   };
   std::deque<PendingRotation> pending_rotations_;
   std::deque<PendingResult> pending_;  ///< LiDAR results ahead of the newest IMU sample

@@ -95,7 +95,15 @@ std::string ScanPipeline::register_frame(FrameResult& out, bool fused_guess, boo
   out.registration = backend_->register_source(out.initial_guess, thresholds, reg, time_budget_s);
   out.registered = true;
   out.inlier_fraction = static_cast<double>(out.registration.system.inliers) / static_cast<double>(out.source_points);
-  std::string failure = registration::failure_reason(out.registration, out.source_points, config_.registration);
+  // The inlier-fraction bar catches a scan of something else (a bogus scan: random points pulled
+  // the pose 1.8 m from the fusion's guess). A scan that sees more new space than mapped space (a
+  // narrow field of view turning into a room of a young map: 9-50 % of the Avia's points matched
+  // as the handheld cut's walker looks around) is as low, but registered from the fusion's guess
+  // it stays within the kernel scale of it: then it stands.
+  RegistrationConfig checks = config_.registration;
+  if (fused_guess && (out.initial_guess.inverse() * out.registration.pose).translation().norm() <= out.kernel_scale_m)
+    checks.min_inlier_fraction = 0.0;
+  std::string failure = registration::failure_reason(out.registration, out.source_points, checks);
   if (failure.empty() && localizing() && out.inlier_fraction < config_.localization.min_inlier_fraction) {
     failure = "not localized: " + std::to_string(static_cast<int>(100.0 * out.inlier_fraction)) +
               " % of the points match the prior map (localization.min_inlier_fraction)";
