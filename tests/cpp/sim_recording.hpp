@@ -49,11 +49,13 @@ inline Scan thinned(const Scan& s, std::size_t k) {
 }
 
 /// `duration_s` of a profile from `motion_start_s` into its motion, every `keep_every`-th point of
-/// each scan.
-inline Recording record(sim::Profile profile, double duration_s, std::size_t keep_every, double motion_start_s = 0.0) {
+/// each scan, with the profile's own LiDAR or a named model.
+inline Recording record(sim::Profile profile, double duration_s, std::size_t keep_every, double motion_start_s = 0.0,
+                        sim::LidarModel lidar_model = sim::LidarModel::Profile) {
   sim::SimConfig cfg = sim::default_config(profile);
   cfg.duration_s = duration_s;
   cfg.motion_start_s = motion_start_s;
+  cfg.lidar_model = lidar_model;
   const sim::SequenceGenerator gen(cfg);
   Recording r;
   // the generator's TBB loops: in an arena of one thread under TSan (kThreadSanitized)

@@ -154,21 +154,23 @@ def test_scans_that_cannot_see_the_motion_do_not_initialise_the_filter(seed):
 #: a Livox Avia model cut 8 s into the handheld walk: the walker slows into a stop facing a wall and
 #: looks around (2.8 rad/s) into rooms the young map has not seen
 AVIA_CUT_S, AVIA_RECORDED_S = 8.0, 20.0
-#: the LIO's scan poses against LiDAR-only's on the same cut: 0.06-0.07 (0.033-0.040 m against 0.56
+#: the LIO's scan poses against LiDAR-only's on the same cut: 0.06-0.07 (0.033-0.039 m against 0.56
 #: m); 0.22-0.33 with two or three re-initialisations when the look-around was registered by the
 #: LiDAR alone and scans seeing mostly new space failed
 AVIA_MAX_LIDAR_ONLY_RATIO = 0.1
+#: rejected LiDAR results: 1 (25-31 before, with two or three re-initialisations)
+AVIA_MAX_REJECTED = 1
 
 
 @pytest.mark.parametrize("seed", SEEDS)
 def test_an_avia_cut_as_the_walker_stops_and_looks_around(seed):
     """The Avia's first scans face a wall (degenerate: the gyro's unit is not judged on them), then the
-    walker turns. The gyro turns the fusion's guess once it turned as the LiDAR did, so the scans of
-    the look-around are not registered by the LiDAR alone (which slid 0.35 m along the wall); from
-    the fusion's guess a scan that sees mostly new space is no failure (its registration stays within
-    the kernel scale of the guess). No re-initialisation, no
-    rejected LiDAR result, no map restart, and the scan poses and 100 Hz odometry within a tenth of
-    LiDAR-only's APE."""
+    walker turns. The gyro turns the fusion's guess once a clear turn that the LiDAR found on its own
+    agrees with it, so the look-around is not registered by the LiDAR alone (which slid 0.35 m along
+    the wall); from the fusion's guess a scan that sees mostly new space is no failure (its
+    registration stays within the kernel scale of the guess). No re-initialisation, no map restart,
+    at most one rejected LiDAR result (the look-around's first scan, registered by the LiDAR alone),
+    and the scan poses and 100 Hz odometry within a tenth of LiDAR-only's APE."""
     rec = Recording(
         make_config("handheld", seed=seed, duration_s=AVIA_RECORDED_S, motion_start_s=AVIA_CUT_S, lidar="avia")
     )
@@ -176,6 +178,6 @@ def test_an_avia_cut_as_the_walker_stops_and_looks_around(seed):
     lidar_only = stretch_accuracy(replay(rec, LIDAR_ONLY))
     what = f"cut {cut}\nLiDAR-only {lidar_only}"
     print(f"Avia handheld from {AVIA_CUT_S} s, seed {seed}: {what}")
-    assert cut["reinit"] == cut["rejected"] == cut["map_restarts"] == 0, what
+    assert cut["reinit"] == cut["map_restarts"] == 0 and cut["rejected"] <= AVIA_MAX_REJECTED, what
     assert cut["ape_m"] <= AVIA_MAX_LIDAR_ONLY_RATIO * lidar_only["ape_m"], what
     assert cut["odom_ape_m"] <= AVIA_MAX_LIDAR_ONLY_RATIO * lidar_only["ape_m"], what

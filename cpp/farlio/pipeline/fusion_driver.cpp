@@ -21,6 +21,11 @@ constexpr int kMotionSamples = 11;
 /// order of the LiDAR's noise, which a deg/s gyro's noise also reaches at rest).
 constexpr double kRotationAgreementRatio = 7.57;
 constexpr double kRotationAgreementFloor_rad = 0.01;
+/// ... and the gyro turns the filter's guess of a turning scan once both it and the LiDAR turned at
+/// least this far over an interval (a degenerate scan's rotation errs by up to 0.023 rad: the Avia
+/// facing a wall) and within this ratio of each other (a deg/s gyro reads 57 times the turn).
+constexpr double kTurnConfirmation_rad = 0.05;
+constexpr double kTurnConfirmationRatio = 2.0;
 /// A gyro whose unit is not decided after this much time comparing it with the LiDAR gets a warning.
 constexpr double kUndecidedGyroWarning_s = 10.0;
 /// Degenerate scans that have kept the filter from starting for this long get a warning.
@@ -362,7 +367,8 @@ void FusionDriver::compare_gyro_unit(std::int64_t stamp_ns, const OdometryFrame&
       stamp_ns <= last_body_->stamp_ns || beyond_bridged_gap(stamp_ns))
     return;
   pending_rotations_.push_back({last_body_->stamp_ns, stamp_ns,
-                                so3_log((last_body_->pose.inverse() * frame.body_pose).rotation()), constrained});
+                                so3_log((last_body_->pose.inverse() * frame.body_pose).rotation()), constrained,
+                                !frame.guess_turned_by_gyro});
   compare_covered_rotations();
 }
 
@@ -374,7 +380,7 @@ void FusionDriver::compare_covered_rotations() {
     const PendingRotation r = pending_rotations_.front();
     pending_rotations_.pop_front();
     const auto gyro_rotation = fusion_->imu_rotation(r.start_ns, r.end_ns);
-    compare_gyro_turn(gyro_rotation, r.lidar_rotation, r.constrained);
+    compare_gyro_turn(gyro_rotation, r);
     if (!r.constrained) continue;
     gyro_unit_.add_lidar_rotation(r.start_ns, r.end_ns, r.lidar_rotation);
     if (gyro_unit_.decided()) apply_gyro_unit();
@@ -383,20 +389,22 @@ void FusionDriver::compare_covered_rotations() {
   if (gyro_unit_.decided()) pending_rotations_.clear();
 }
 
-void FusionDriver::compare_gyro_turn(const std::optional<Eigen::Matrix3d>& gyro_rotation,
-                                     const Eigen::Vector3d& lidar_rotation, bool constrained) {
-  // a gyro that turned more than 7.6 times as far as the LiDAR (give or take the floor) does not
-  // follow it. gyro_follows_lidar_ (the guess before the filter) is judged on scans that constrain
-  // every direction and holds on rotations within the floor; gyro_turn_confirmed_ (the filter's
-  // guess of a turning scan) on every scan, and only a turn of the LiDAR by the floor or more
-  // confirms it: a deg/s gyro reads 57 times a turn that small within the floor too
+void FusionDriver::compare_gyro_turn(const std::optional<Eigen::Matrix3d>& gyro_rotation, const PendingRotation& r) {
+  // gyro_follows_lidar_ (the guess before the filter) is judged on scans that constrain every
+  // direction: the gyro turned no more than kRotationAgreementRatio times as far as the LiDAR, give
+  // or take the floor. gyro_turn_confirmed_ (the filter's guess of a turning scan) is judged on
+  // every scan: refuted the same way, confirmed only by a clear turn of both that the LiDAR found
+  // from a guess the gyro did not turn (a degenerate scan registered from the gyro's guess follows
+  // it: the Avia facing a wall with a deg/s gyro confirmed it that way and ran 128 m off)
   const double gyro_rad = gyro_rotation ? so3_log(*gyro_rotation).norm() : 0.0;
-  const bool within =
-      gyro_rotation && gyro_rad <= kRotationAgreementRatio * lidar_rotation.norm() + kRotationAgreementFloor_rad;
-  if (constrained) gyro_follows_lidar_ = within;
+  const double lidar_rad = r.lidar_rotation.norm();
+  const bool within = gyro_rotation && gyro_rad <= kRotationAgreementRatio * lidar_rad + kRotationAgreementFloor_rad;
+  if (r.constrained) gyro_follows_lidar_ = within;
+  const bool clear_turn = std::min(gyro_rad, lidar_rad) >= kTurnConfirmation_rad &&
+                          std::max(gyro_rad, lidar_rad) <= kTurnConfirmationRatio * std::min(gyro_rad, lidar_rad);
   if (!within)
     gyro_turn_confirmed_ = false;
-  else if (lidar_rotation.norm() >= kRotationAgreementFloor_rad)
+  else if (gyro_rotation && clear_turn && r.lidar_own_guess)
     gyro_turn_confirmed_ = true;
 }
 

@@ -156,10 +156,6 @@ class FusionDriver {
   void jump_clock(const ImuSample& sample);
   /// After the gyro unit was decided: scales and restarts, or ends the fusion.
   void apply_gyro_unit();
-  /// gyro_follows_lidar_ and gyro_turn_confirmed_ from one interval's rotations (gyro: nullopt
-  /// where the IMU does not cover it; constrained: the later scan constrains every direction).
-  void compare_gyro_turn(const std::optional<Eigen::Matrix3d>& gyro_rotation, const Eigen::Vector3d& lidar_rotation,
-                         bool constrained);
   /// Whether the registration held the frame's degenerate directions at the fusion's prior.
   [[nodiscard]] bool held_at_prior(const OdometryFrame& frame) const;
   /// The registration's pose covariance in the body frame (its degenerate rotation axes released
@@ -222,9 +218,13 @@ class FusionDriver {
     std::int64_t start_ns = 0;
     std::int64_t end_ns = 0;
     Eigen::Vector3d lidar_rotation = Eigen::Vector3d::Zero();
-    bool constrained = true;  ///< the later scan constrains every direction: the unit is judged on it
+    bool constrained = true;      ///< the later scan constrains every direction: the unit is judged on it
+    bool lidar_own_guess = true;  ///< the later scan was registered from a guess the gyro did not turn
   };
   std::deque<PendingRotation> pending_rotations_;
+  /// gyro_follows_lidar_ and gyro_turn_confirmed_ from one interval's rotations (gyro: nullopt
+  /// where the IMU does not cover it).
+  void compare_gyro_turn(const std::optional<Eigen::Matrix3d>& gyro_rotation, const PendingRotation& r);
   std::deque<PendingResult> pending_;  ///< LiDAR results ahead of the newest IMU sample
   std::vector<std::string> warnings_;
 };

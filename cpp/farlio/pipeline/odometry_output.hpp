@@ -16,14 +16,15 @@ namespace farlio::pipeline {
 
 /// What happened to one scan.
 struct OdometryFrame {
-  FrameResult scan;                ///< the scan pipeline's result (LiDAR pose, timings, ...)
-  SE3 body_pose;                   ///< registered body pose at the scan end
-  bool processed = false;          ///< false: dropped before registration (pipeline busy)
-  bool fused = false;              ///< the result reached the fusion
-  std::string drop_reason;         ///< why it was not processed or not fused
-  std::int64_t started_ns = 0;     ///< when the pipeline started on it (the odometry's clock)
-  std::int64_t available_ns = 0;   ///< when its result reached the fusion
-  bool guess_from_fusion = false;  ///< initial guess and undistortion came from the fusion
+  FrameResult scan;                   ///< the scan pipeline's result (LiDAR pose, timings, ...)
+  SE3 body_pose;                      ///< registered body pose at the scan end
+  bool processed = false;             ///< false: dropped before registration (pipeline busy)
+  bool fused = false;                 ///< the result reached the fusion
+  std::string drop_reason;            ///< why it was not processed or not fused
+  std::int64_t started_ns = 0;        ///< when the pipeline started on it (the odometry's clock)
+  std::int64_t available_ns = 0;      ///< when its result reached the fusion
+  bool guess_from_fusion = false;     ///< initial guess and undistortion came from the fusion
+  bool guess_turned_by_gyro = false;  ///< the guess turned as the gyro did (the fusion's, or the one before the filter)
   /// How well the registration constrained the body pose (registered scans only).
   std::optional<registration::Degeneracy> degeneracy;
   /// The registered scan: the kept (undistorted, downsampled) points in the world frame at the
