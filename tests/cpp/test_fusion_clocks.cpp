@@ -52,6 +52,12 @@ const Recording& handheld_every_point() {
   return r;
 }
 
+/// The same samples with the gyro in deg/s.
+std::vector<ImuSample> in_degrees_per_second(std::vector<ImuSample> imu) {
+  for (auto& s : imu) s.gyro_rad_s *= kDegPerRad;
+  return imu;
+}
+
 bool contains(const std::vector<std::string>& warnings, const std::string& fragment) {
   return std::any_of(warnings.begin(), warnings.end(),
                      [&](const std::string& w) { return w.find(fragment) != std::string::npos; });
@@ -399,8 +405,7 @@ TEST(ReplayClocks, AFirstScanAfterTheImuEndsIsAnError) {
 
 TEST(ReplayClocks, AGyroInDegreesPerSecondIsScaled) {
   const Recording& rec = handheld_every_point();
-  std::vector<ImuSample> deg = rec.imu;
-  for (auto& s : deg) s.gyro_rad_s *= kDegPerRad;
+  const std::vector<ImuSample> deg = in_degrees_per_second(rec.imu);
   const ReplayRun normal = replay(rec, rec.imu);
   const ReplayRun run = replay(rec, deg);
   EXPECT_TRUE(contains(run.warnings, "the gyro reports in deg/s")) << joined(run.warnings);
@@ -420,8 +425,7 @@ TEST(ReplayClocks, AGyroInDegreesPerSecondIsScaled) {
 // 4 s, 128 m over 20 s).
 TEST(ReplayClocks, AGyroInDegreesPerSecondFacingAWallIsFound) {
   static const Recording rec = test::record(sim::Profile::Handheld, 4.0, 1, 8.0, sim::LidarModel::Avia);
-  std::vector<ImuSample> deg = rec.imu;
-  for (auto& s : deg) s.gyro_rad_s *= kDegPerRad;
+  const std::vector<ImuSample> deg = in_degrees_per_second(rec.imu);
   const ReplayRun normal = replay(rec, rec.imu);
   const ReplayRun run = replay(rec, deg);
   EXPECT_TRUE(contains(run.warnings, "the gyro reports in deg/s")) << joined(run.warnings);
@@ -454,8 +458,7 @@ TEST(ReplayClocks, AnUndecidedGyroUnitIsAWarning) {
   // the generator's urban drive goes straight for its first 12 s without any rotation: a gyro in
   // deg/s cannot be told from one in rad/s, and the run says so (before: nothing was said)
   static const Recording straight = test::record(sim::Profile::Urban, 12.0, kKeepEvery);
-  std::vector<ImuSample> deg = straight.imu;
-  for (auto& s : deg) s.gyro_rad_s *= kDegPerRad;
+  const std::vector<ImuSample> deg = in_degrees_per_second(straight.imu);
   const ReplayRun run = replay(straight, deg);
   EXPECT_TRUE(contains(run.warnings, "the gyro's unit (rad/s or deg/s) is not decided after 10.000 s"))
       << joined(run.warnings);
