@@ -52,6 +52,15 @@ bool in_gravity_window(const ImuSample& first, const ImuSample& s) {
 
 }  // namespace
 
+void register_from_prior(ScanPipeline& pipeline, const Scan& scan, const ScanPrior& prior, const SE3& T_lidar_imu,
+                         OdometryFrame& out) {
+  out.guess_from_fusion = prior.guess.has_value() && prior.fused;
+  out.guess_turned_by_gyro = prior.guess.has_value();  // every guess the driver gives turns with the gyro
+  out.scan = pipeline.process(scan, prior.guess, prior.motion, prior.fused, prior.confirmed);
+  out.processed = true;
+  out.body_pose = out.scan.pose * T_lidar_imu;
+}
+
 SE3 gravity_aligned_start(const std::vector<ImuSample>& imu, std::int64_t until_ns, double gravity_m_s2,
                           double max_gyro_rad_s) {
   if (imu.empty() || imu.front().stamp_ns > until_ns) return SE3();
@@ -291,9 +300,9 @@ ScanPrior FusionDriver::prior(const Scan& scan, const registration::Vec6d& lidar
   if (fusion_->initialized()) {
     // while the gyro's unit is undecided, a scan during which it turns is registered by the LiDAR
     // alone (a deg/s gyro would turn the guess 57 times too far, and the registration would
-    // follow), unless the gyro turned as the LiDAR did in the last turn they both made (a narrow
-    // field of view facing a wall as the body looks around: its scans do not constrain every
-    // direction, the unit is not judged on them, and the LiDAR alone slides along the wall)
+    // follow), unless a clear turn confirmed the gyro (compare_gyro_turn: a narrow field of view
+    // facing a wall as the body looks around; its scans do not constrain every direction, the unit
+    // is not judged on them, and the LiDAR alone slides along the wall)
     if (gyro_unit_.turning(scan.start_stamp_ns, scan.end_stamp_ns) && !gyro_turn_confirmed_) return prior;
     if (const auto body = fusion_->pose_at(scan.end_stamp_ns)) {
       prior.guess = *body * T_imu_lidar_;
@@ -404,7 +413,7 @@ void FusionDriver::compare_gyro_turn(const std::optional<Eigen::Matrix3d>& gyro_
                           std::max(gyro_rad, lidar_rad) <= kTurnConfirmationRatio * std::min(gyro_rad, lidar_rad);
   if (!within)
     gyro_turn_confirmed_ = false;
-  else if (gyro_rotation && clear_turn && r.lidar_own_guess)
+  else if (clear_turn && r.lidar_own_guess)
     gyro_turn_confirmed_ = true;
 }
 

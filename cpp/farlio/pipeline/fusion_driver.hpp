@@ -77,6 +77,12 @@ struct ScanPrior {
   bool confirmed = false;                    ///< fused, with the gyro's unit decided against the LiDAR
 };
 
+/// `scan` registered by `pipeline` from `prior` into `out`: the pipeline's result, the body pose
+/// (T_lidar_imu at the LiDAR pose), processed, and where the guess came from (which the gyro's
+/// unit check reads). The replay (Odometry) and the online odometry both register this way.
+void register_from_prior(ScanPipeline& pipeline, const Scan& scan, const ScanPrior& prior, const SE3& T_lidar_imu,
+                         OdometryFrame& out);
+
 /// A LiDAR result for the fusion (FusionDriver::link): the body pose at the scan end, its
 /// registration covariance, and the velocity from the previous result (eq. 6).
 struct PendingResult {
@@ -204,7 +210,7 @@ class FusionDriver {
   bool warned_no_imu_ = false;                     ///< a scan came before the first IMU sample
   std::optional<std::int64_t> first_compared_ns_;  ///< the first scan the gyro's unit was compared at
   bool gyro_follows_lidar_ = false;                ///< the gyro turned as the LiDAR between the last two scans compared
-  bool gyro_turn_confirmed_ = false;               ///< ... in the last interval in which either turned beyond the floor
+  bool gyro_turn_confirmed_ = false;  ///< a clear turn agreed with the gyro, and no interval since disagreed
   bool warned_undecided_gyro_ = false;
   std::optional<std::int64_t> first_degenerate_start_ns_;  ///< the first degenerate scan before the filter
   bool warned_degenerate_start_ = false;

@@ -142,11 +142,7 @@ OdometryFrame Odometry::process(const Scan& scan) {
   }
 
   const ScanPrior prior = driver_.prior(scan, pipeline_.last_twist());
-  out.guess_from_fusion = prior.guess.has_value() && prior.fused;
-  out.guess_turned_by_gyro = prior.guess.has_value();
-  out.scan = pipeline_.process(scan, prior.guess, prior.motion, prior.fused, prior.confirmed);
-  out.processed = true;
-  out.body_pose = out.scan.pose * T_lidar_imu_;
+  register_from_prior(pipeline_, scan, prior, T_lidar_imu_, out);
   out.available_ns = out.started_ns + seconds_to_ns(latency_s(out.scan));
   busy_until_ns_ = out.available_ns;
 

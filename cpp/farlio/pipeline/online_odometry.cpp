@@ -129,10 +129,7 @@ OdometryFrame OnlineOdometry::process(const Scan& scan) {
     prior = driver_.prior(scan, pipeline_.last_twist());
     out.started_ns = fused_clock() ? driver_.clock_ns() : scan.end_stamp_ns;
   }
-  out.guess_from_fusion = prior.guess.has_value() && prior.fused;
-  out.scan = pipeline_.process(scan, prior.guess, prior.motion, prior.fused, prior.confirmed);
-  out.processed = true;
-  out.body_pose = out.scan.pose * T_lidar_imu_;
+  register_from_prior(pipeline_, scan, prior, T_lidar_imu_, out);
   if (keep_registered_points_) {
     out.registered_points = pipeline_.backend().frame_points();
     const Eigen::Matrix3f R = out.scan.pose.rotation().cast<float>();
