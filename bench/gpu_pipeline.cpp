@@ -4,8 +4,13 @@
 // median and p99 (CUDA events on the GPU), device memory, and the pose agreement of the two
 // backends; then the scan's upload time and the effective bandwidth of the k-NN and the GICP
 // reduction against a device-to-device copy. Run by scripts/gpu_check.sh.
+// On the GPU each sequence runs twice: with each scan uploaded in its own frame (a live scan's
+// latency), and with the next scan staged before each frame (ScanPipeline::stage_next: offline,
+// scans back to back, its upload overlaps the frame's kernels); the row "NAME+next" is the second,
+// its dt_max / dr_max the largest pose difference to the first (0: the same results).
 // Usage: gpu_pipeline [--frames N] [--profile urban|racetrack|handheld|tunnel]... [--scans DIR]...
-//                     [--device cuda|cpu|auto] [--no-cpu-compare] [--repeats R]
+//                     [--device cuda|cpu|auto] [--no-cpu-compare] [--no-staged] [--repeats R]
+// --no-staged: without the run with the next scan staged.
 // --repeats R: launches timed per bandwidth sample (0: no bandwidth samples).
 // --scans DIR: every point cloud file of DIR (PCD, PLY, KITTI .bin, optionally .gz), in name
 // order, as scans 0.1 s apart without per-point times (KITTI's scans are already undistorted).
@@ -50,6 +55,7 @@ struct Options {
   std::vector<std::string> scan_dirs;
   Device device = Device::Cuda;
   bool compare_cpu = true;
+  bool staged = true;
   int repeats = kDefaultRepeats;
 };
 
@@ -71,6 +77,8 @@ Options parse(int argc, char** argv) {
       o.device = parse_device(value(), "--device");
     else if (a == "--no-cpu-compare")
       o.compare_cpu = false;
+    else if (a == "--no-staged")
+      o.staged = false;
     else if (a == "--repeats")
       o.repeats = std::stoi(value());
     else
@@ -133,10 +141,13 @@ struct Run {
   bool device_timed = false;
 };
 
-Run run(pipeline::ScanPipeline& p, const std::vector<Scan>& scans, double used_before) {
+/// `stage_next`: the next scan is handed to the pipeline before each frame (in the frame's time).
+Run run(pipeline::ScanPipeline& p, const std::vector<Scan>& scans, double used_before, bool stage_next = false) {
   Run r;
-  for (const Scan& s : scans) {
+  for (std::size_t i = 0; i < scans.size(); ++i) {
+    const Scan& s = scans[i];
     const auto t0 = std::chrono::steady_clock::now();
+    if (stage_next && i + 1 < scans.size()) p.stage_next(scans[i + 1]);
     const auto f = p.process(s);
     r.total_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     const double st[kStages] = {f.timings.preprocess_s, f.timings.covariance_s, f.timings.registration_s,
@@ -224,6 +235,18 @@ int main(int argc, char** argv) {
                     quantile(rc.total_ms, kMedian) / quantile(r.total_ms, kMedian));
       } else {
         print_row(name, points, p.backend().device(), r, NAN, NAN);
+      }
+      if (o.staged && p.backend().device() == Device::Cuda) {
+        const double used_by_the_first = device_used_bytes();
+        pipeline::ScanPipeline staged(cfg);
+        const Run rs = run(staged, scans, used_by_the_first, true);
+        double dt = 0.0, dr = 0.0;
+        for (std::size_t i = 0; i < scans.size(); ++i) {
+          const SE3 d = r.poses[i].inverse() * rs.poses[i];
+          dt = std::max(dt, d.translation().norm());
+          dr = std::max(dr, d.angle_rad() * 180.0 / M_PI);
+        }
+        print_row(name + "+next", points, staged.backend().device(), rs, dt, dr);
       }
       print_bandwidth(p, o.repeats, quantile(r.total_ms, kMedian));
     }

@@ -26,6 +26,8 @@ namespace {
 struct PyScanPipeline {
   std::mutex mutex;
   pipeline::ScanPipeline pipeline;
+  /// The scans last staged: alive while the backend may still read them (the GIL guards these).
+  nb::object staged[2];
   PyScanPipeline(const Config& c, const SE3& initial_pose) : pipeline(c, initial_pose) {}
 };
 
@@ -45,6 +47,18 @@ void bind_scan_pipeline(nb::module_& m) {
           "scan"_a, "initial_guess"_a = nb::none(), nb::call_guard<nb::gil_scoped_release>(),
           "Registers one scan; without a guess the constant-velocity model supplies one. Points with NaN or Inf "
           "coordinates or times are dropped (FrameResult.non_finite_points).")
+      .def(
+          "stage_next",
+          [](PyScanPipeline& p, nb::handle scan) {
+            const Scan& s = nb::cast<const Scan&>(scan);
+            p.staged[0] = std::move(p.staged[1]);
+            p.staged[1] = nb::borrow(scan);
+            locked(p, [&](PyScanPipeline& x) { x.pipeline.stage_next(s); });
+          },
+          "scan"_a,
+          "Offline, scans back to back: the scan after the one about to be processed, so that the CUDA backend "
+          "uploads it while it works (the CPU backend has nothing to move). Process that same object, unchanged; any "
+          "other scan is uploaded in its own frame. The results are the same.")
       .def_prop_ro("frames",
                    [](PyScanPipeline& p) { return locked(p, [](PyScanPipeline& x) { return x.pipeline.frames(); }); })
       .def(

@@ -24,7 +24,8 @@
 # Environment: BUILD (default build/gpu), CUDA_ARCH (default native), FRAMES (default 100),
 # JOBS (default nproc), SCANS (a folder of scans for the timing), SKIP_SANITIZERS=1,
 # PREBUILT (a folder made by --pack: run its binaries, build nothing), BASELINE (likewise, the
-# build to compare with), NCU=1, PYTHON=1.
+# build to compare with), BASELINE_ARGS (what its profiled gpu_pipeline is given to run each
+# sequence once: --no-staged, the default; '' for a build older than that option), NCU=1, PYTHON=1.
 #
 #   scripts/gpu_check.sh --pack DIR   (on the build machine, after building BUILD with CUDA)
 # copies the two executables, stripped, and the shared libraries they need that are not the C
@@ -182,16 +183,18 @@ if [ "${NCU:-0}" = 1 ]; then
   if [ -z "$NCU_BIN" ]; then
     summary+=("kernel profile (ncu)         NOT FOUND")
   else
-    # kernel_profile NAME BIN_DIR LIBS CSV: ncu's durations of that build's kernels, per frame
+    # kernel_profile NAME BIN_DIR LIBS CSV [ARGS]: ncu's durations of that build's kernels, per
+    # frame, over one run of the frames (this build's --no-staged: not the second, staged run)
     kernel_profile() {
       step "$1" "$4.log" "$BENCH_LIMIT_S" bash -c "LD_LIBRARY_PATH='$3' '$NCU_BIN' --clock-control none --metrics \
         gpu__time_duration.sum --csv --page raw '$2/gpu_pipeline' --frames $NCU_FRAMES --profile urban \
-        --no-cpu-compare --repeats 0 > '$LOGS/$4.csv' && python3 scripts/gpu_kernel_table.py '$LOGS/$4.csv' $NCU_FRAMES"
+        --no-cpu-compare --repeats 0 ${5:-} > '$LOGS/$4.csv' && python3 scripts/gpu_kernel_table.py '$LOGS/$4.csv' $NCU_FRAMES"
     }
-    kernel_profile "kernel profile (ncu)" "$bin" "${LD_LIBRARY_PATH:-}" ncu || status=1
+    kernel_profile "kernel profile (ncu)" "$bin" "${LD_LIBRARY_PATH:-}" ncu --no-staged || status=1
     if [ -n "${BASELINE:-}" ]; then
+      # a build from before --no-staged (BASELINE_ARGS='' for one) ran each sequence once
       kernel_profile "baseline kernel profile (ncu)" "$BASELINE/bin" "$PWD/$BASELINE/lib:${LD_LIBRARY_PATH:-}" \
-        ncu_baseline || status=1
+        ncu_baseline "${BASELINE_ARGS---no-staged}" || status=1
     fi
   fi
 fi

@@ -6,6 +6,7 @@
 #include "farlio/core/device.hpp"
 #include "farlio/pipeline/backend_availability.hpp"
 #include "farlio/pipeline/scan_pipeline.hpp"
+#include "farlio/sim/sequence_generator.hpp"
 
 using namespace farlio;
 
@@ -60,4 +61,27 @@ TEST(Device, CudaWithoutAGpuIsAClearError) {
     EXPECT_NE(what.find("device cuda was requested"), std::string::npos) << what;
     EXPECT_NE(what.find(cuda_compiled() ? "no CUDA device" : "no CUDA backend"), std::string::npos) << what;
   }
+}
+
+TEST(Device, OnTheCpuAStagedScanChangesNothing) {
+  // the CPU backend has nothing to move: staging the next scan leaves every result as it was
+  constexpr std::size_t kFirst = 25, kScans = 5;  // generated urban starts with 2.5 s at rest
+  sim::SimConfig sc = sim::default_config(sim::Profile::Urban);
+  sc.duration_s = 0.1 * static_cast<double>(kFirst + kScans + 1);
+  const sim::SequenceGenerator gen(sc);
+  std::vector<Scan> scans;
+  for (std::size_t i = kFirst; i < kFirst + kScans; ++i) scans.push_back(gen.scan(i));
+  Config c;
+  c.device = Device::Cpu;
+  c.registration.time_budget_factor = 1e6;  // compare results, not the time budget
+  pipeline::ScanPipeline plain(c), staged(c);
+  for (std::size_t i = 0; i < scans.size(); ++i) {
+    if (i + 1 < scans.size()) staged.stage_next(scans[i + 1]);
+    const auto a = plain.process(scans[i]);
+    const auto b = staged.process(scans[i]);
+    EXPECT_FALSE(staged.backend().last_scan_was_staged());
+    EXPECT_EQ(a.pose.translation(), b.pose.translation());
+    EXPECT_EQ(a.kept_points, b.kept_points);
+  }
+  EXPECT_EQ(staged.frames(), kScans);
 }

@@ -156,3 +156,85 @@ TEST(CudaPipeline, EmptyTinyAndNonFiniteScansGoAsOnTheCpu) {
   EXPECT_NEAR(static_cast<double>(gpu.backend().map_points()), static_cast<double>(cpu.backend().map_points()),
               0.01 * static_cast<double>(cpu.backend().map_points()));
 }
+
+namespace {
+
+/// The frames' poses and the submap of `p` equal those of `q` exactly (the same kernels on the
+/// same data: the results are the same bits).
+void expect_same_map(const pipeline::ScanPipeline& p, const pipeline::ScanPipeline& q) {
+  const map::MapSnapshot a = p.backend().map_snapshot(), b = q.backend().map_snapshot();
+  EXPECT_EQ(a.voxel_keys, b.voxel_keys);
+  EXPECT_EQ(a.voxel_counts, b.voxel_counts);
+  EXPECT_TRUE(a.points == b.points);
+}
+
+void expect_same_pose(const pipeline::FrameResult& a, const pipeline::FrameResult& b) {
+  EXPECT_EQ(a.pose.translation(), b.pose.translation());
+  EXPECT_EQ(a.pose.rotation(), b.pose.rotation());
+  EXPECT_EQ(a.kept_points, b.kept_points);
+  EXPECT_EQ(a.source_points, b.source_points);
+}
+
+}  // namespace
+
+TEST(CudaPipeline, ScansStagedBackToBackGiveTheSameBitsAsScansUploadedInTheirFrame) {
+  // offline use: the next scan is staged before each frame, so its upload overlaps the frame's
+  // kernels; every scan after the first must be found staged, and nothing may change
+  FARLIO_REQUIRE_GPU();
+  constexpr std::size_t kStagedFrames = 12;
+  sim::SimConfig sc = sim::default_config(sim::Profile::Urban);
+  sc.duration_s = 0.1 * static_cast<double>(kSkipAtRest + kStagedFrames + 1);
+  const sim::SequenceGenerator gen(sc);
+  std::vector<Scan> scans;
+  for (std::size_t i = kSkipAtRest; i < kSkipAtRest + kStagedFrames; ++i) scans.push_back(gen.scan(i));
+  pipeline::ScanPipeline plain(config_on(Device::Cuda)), staged(config_on(Device::Cuda));
+  for (std::size_t i = 0; i < scans.size(); ++i) {
+    SCOPED_TRACE("frame " + std::to_string(i));
+    if (i + 1 < scans.size()) staged.stage_next(scans[i + 1]);
+    const auto a = plain.process(scans[i]);
+    const auto b = staged.process(scans[i]);
+    EXPECT_FALSE(plain.backend().last_scan_was_staged());
+    EXPECT_EQ(staged.backend().last_scan_was_staged(), i > 0);
+    expect_same_pose(a, b);
+  }
+  expect_same_map(plain, staged);
+}
+
+TEST(CudaPipeline, AScanOtherThanTheStagedOnesIsUploadedInItsFrame) {
+  // staging out of step with processing: a scan processed without staging, three scans staged
+  // ahead (with two slots, the older staged scan gives way), a copy of a scan staged instead of
+  // the scan itself, a scan staged twice; each scan still gives the bits of a plain run, and is
+  // found staged only when the object itself was staged and is still held
+  FARLIO_REQUIRE_GPU();
+  constexpr std::size_t kScans = 8;
+  sim::SimConfig sc = sim::default_config(sim::Profile::Urban);
+  sc.duration_s = 0.1 * static_cast<double>(kSkipAtRest + kScans + 1);
+  const sim::SequenceGenerator gen(sc);
+  std::vector<Scan> s;
+  for (std::size_t i = kSkipAtRest; i < kSkipAtRest + kScans; ++i) s.push_back(gen.scan(i));
+  pipeline::ScanPipeline plain(config_on(Device::Cuda)), staged(config_on(Device::Cuda));
+  const auto step = [&](std::size_t k, bool expect_staged) {
+    SCOPED_TRACE("scan " + std::to_string(k));
+    const auto a = plain.process(s[k]);
+    const auto b = staged.process(s[k]);
+    EXPECT_EQ(staged.backend().last_scan_was_staged(), expect_staged);
+    expect_same_pose(a, b);
+  };
+  staged.stage_next(s[1]);
+  step(0, false);  // s1 waits staged
+  staged.stage_next(s[2]);
+  step(1, true);
+  staged.stage_next(s[3]);  // s2 and s3 wait staged
+  staged.stage_next(s[4]);  // both slots hold one: s2, the older, is dropped
+  step(2, false);           // uploaded in its frame, into s3's slot (now the older)
+  step(3, false);
+  step(4, true);
+  const Scan copy = s[5];  // the same points in another object: not the scan staged
+  staged.stage_next(copy);
+  step(5, false);
+  staged.stage_next(s[6]);
+  staged.stage_next(s[6]);  // twice: either copy serves
+  step(6, true);
+  step(7, false);
+  expect_same_map(plain, staged);
+}

@@ -103,3 +103,22 @@ def test_calls_from_several_threads_are_serialised(urban, kind):
     assert all(math.isfinite(float(np.asarray(r.pose.translation)[0])) for r in results)
     if kind == "ScanPipeline":
         assert obj.frames == SCANS
+
+
+def test_a_staged_next_scan_changes_no_result(urban):
+    """Offline loops may hand the pipeline the scan after the one about to be processed
+    (ScanPipeline.stage_next; on the GPU it is uploaded while the frame runs): the same bits as
+    without, on whichever device runs. The pipeline holds the scans staged last, so that one handed
+    over as a temporary is safe; a scan never processed is simply dropped."""
+    scans, _, _ = urban
+    config = _core.Config()
+    config.set("registration.time_budget_factor", "1000")
+    plain, staged = _core.ScanPipeline(config), _core.ScanPipeline(config)
+    staged.stage_next(with_times(scans[0], np.asarray(scans[0].time_s)))  # a temporary, never processed
+    for i, scan in enumerate(scans):
+        if i + 1 < len(scans):
+            staged.stage_next(scans[i + 1])
+        a, b = plain.process(scan), staged.process(scan)
+        assert np.array_equal(a.pose.matrix(), b.pose.matrix())
+        assert a.kept_points == b.kept_points and a.source_points == b.source_points
+    assert staged.frames == plain.frames == len(scans)

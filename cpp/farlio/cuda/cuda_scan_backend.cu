@@ -7,8 +7,8 @@
 #include "farlio/cuda/device_buffer.hpp"
 #include "farlio/cuda/device_voxel_map.hpp"
 #include "farlio/cuda/map_scratch.hpp"
+#include "farlio/cuda/scan_slots.hpp"
 #include "farlio/cuda/stage_timer.hpp"
-#include "farlio/cuda/staged_upload.hpp"
 #include "farlio/cuda/warp_search.cuh"
 #include "farlio/exec/atomics.hpp"
 #include "farlio/map/voxel_update.hpp"
@@ -54,15 +54,13 @@ class CudaScanBackend final : public pipeline::ScanBackend {
              scratch_),
         frame_map_(pipeline::frame_map_config(config), checked_size(config.cuda.max_frame_voxels, kFrameMapParameter),
                    kFrameMapParameter, executor_, algorithms_, scratch_),
-        raw_(max_points_, "scan points"),
-        times_(max_points_, "scan points"),
+        scans_(max_points_, config.num_threads, executor_.stream()),
         frame_(max_points_, "scan points"),
         world_(max_points_, "scan points"),
         source_points_(max_points_, "source points"),
         source_covs_(max_points_, "source points"),
         matches_(max_points_, "source points"),
         dropped_(1, "non-finite point counts"),
-        staging_(max_points_ * (sizeof(Eigen::Vector3f) + sizeof(float)), config.num_threads),
         timer_(executor_.stream()) {
     executor_.synchronize();  // the buffers' initialisation has run
   }
@@ -76,6 +74,9 @@ class CudaScanBackend final : public pipeline::ScanBackend {
     map_points_ = 0;
   }
 
+  void stage_next(const Scan& next) override { scans_.stage(next); }
+  [[nodiscard]] bool last_scan_was_staged() const override { return scans_.last_was_staged(); }
+
   std::size_t preprocess(const Scan& scan, const deskew::ScanMotion& motion, bool undistort) override {
     timer_.new_frame();
     timer_.start(StageTimer::kPreprocess);
@@ -83,14 +84,12 @@ class CudaScanBackend final : public pipeline::ScanBackend {
     // the times go up whenever the scan has them: a point with a non-finite time is dropped too
     const bool times = scan.has_time();
     upload_bytes_ = n * (sizeof(Eigen::Vector3f) + (times ? sizeof(float) : 0));
-    raw_.require(n, kScanParameter);
-    staging_.begin_frame();
-    staging_.upload(scan.points.data(), raw_.data(), n * sizeof(Eigen::Vector3f), executor_.stream());
-    if (times) staging_.upload(scan.time_s.data(), times_.data(), n * sizeof(float), executor_.stream());
+    const ScanSlots::Slot slot = scans_.take(scan, times);  // staged by stage_next, or uploaded now
     non_finite_points_ = 0;
-    frame_size_ = n == 0 ? 0
-                         : downsample(n, deskew::DeskewTable::sample(motion, static_cast<float>(scan.duration_s())),
-                                      undistort, times);
+    frame_size_ = n == 0
+                      ? 0
+                      : downsample(slot, n, deskew::DeskewTable::sample(motion, static_cast<float>(scan.duration_s())),
+                                   undistort, times);
     timer_.stop(StageTimer::kPreprocess);
     return frame_size_;
   }
@@ -102,11 +101,12 @@ class CudaScanBackend final : public pipeline::ScanBackend {
   /// as CpuScanBackend::preprocess on the scan without its non-finite points. The cells' points
   /// are taken before the host reads the cell count: one thread a scan point, those past the
   /// count (on the device) idle.
-  std::size_t downsample(std::size_t n, const deskew::DeskewTable& motion, bool undistort, bool times) {
+  std::size_t downsample(const ScanSlots::Slot& slot, std::size_t n, const deskew::DeskewTable& motion, bool undistort,
+                         bool times) {
     const preprocess::PreprocessParams pp{preprocess::RangeCrop::from(config_.preprocess), motion, undistort,
                                           1.0f / map_.spacing_m()};
-    const Eigen::Vector3f* raw = raw_.data();
-    const float* time = times ? times_.data() : nullptr;
+    const Eigen::Vector3f* raw = slot.points;
+    const float* time = times ? slot.times : nullptr;
     std::uint64_t* keys = scratch_.keys.data();
     std::int32_t* dropped = dropped_.data();
     FARLIO_CUDA_CHECK(cudaMemsetAsync(dropped, 0, sizeof(std::int32_t), executor_.stream()));
@@ -123,7 +123,7 @@ class CudaScanBackend final : public pipeline::ScanBackend {
                                                static_cast<double>(pp.inv_cell_m));
     ReadSlot<std::int32_t> non_finite;
     const std::size_t cells = sort_into_groups(scratch_, executor_, algorithms_, n, window, [&](ReadBack& rb) {
-                                take_cell_points(n, pp, undistort);
+                                take_cell_points(slot, n, pp, undistort);
                                 non_finite = rb.post(dropped_.data());
                               }).groups;
     non_finite_points_ = static_cast<std::size_t>(executor_.read_back().value(non_finite));
@@ -132,9 +132,10 @@ class CudaScanBackend final : public pipeline::ScanBackend {
 
   /// frame[g] = the first point of cell g, undistorted: one thread a scan point (n), those past
   /// the cell count (on the device) idle.
-  void take_cell_points(std::size_t n, const preprocess::PreprocessParams& pp, bool undistort) {
-    const Eigen::Vector3f* raw = raw_.data();
-    const float* times = times_.data();
+  void take_cell_points(const ScanSlots::Slot& slot, std::size_t n, const preprocess::PreprocessParams& pp,
+                        bool undistort) {
+    const Eigen::Vector3f* raw = slot.points;
+    const float* times = slot.times;
     const std::int32_t* cells = scratch_.scalars.data() + kScalarGroups;
     const std::int32_t* starts = scratch_.group_start.data();
     const std::int32_t* order = scratch_.sorted_order.data();
@@ -259,7 +260,7 @@ class CudaScanBackend final : public pipeline::ScanBackend {
 
   [[nodiscard]] std::size_t memory_bytes() const override {
     return executor_.memory_bytes() + algorithms_.memory_bytes() + scratch_.memory_bytes() + map_.memory_bytes() +
-           frame_map_.memory_bytes() + raw_.bytes() + times_.bytes() + frame_.bytes() + world_.bytes() +
+           frame_map_.memory_bytes() + scans_.device_bytes() + frame_.bytes() + world_.bytes() +
            source_points_.bytes() + source_covs_.bytes() + matches_.bytes() + dropped_.bytes();
   }
 
@@ -274,7 +275,7 @@ class CudaScanBackend final : public pipeline::ScanBackend {
 
   std::vector<BandwidthSample> measure_bandwidth(int repeats) {
     std::vector<BandwidthSample> out{measure_copy(executor_, kCopyBytes, repeats)};
-    if (upload_bytes_ > 0) out.push_back(measure_upload(executor_, staging_, upload_bytes_, repeats));
+    if (upload_bytes_ > 0) out.push_back(measure_upload(executor_, scans_.frame_staging(), upload_bytes_, repeats));
     const std::size_t n = map_.num_points();
     DeviceBuffer<Eigen::Vector4f> points(n, "map points");
     DeviceBuffer<map::Cov3> covs(n, "map points");
@@ -318,15 +319,13 @@ class CudaScanBackend final : public pipeline::ScanBackend {
   MapScratch scratch_;
   DeviceVoxelMap map_;
   DeviceVoxelMap frame_map_;
-  DeviceBuffer<Eigen::Vector3f> raw_;
-  DeviceBuffer<float> times_;
+  ScanSlots scans_;                      // the scan's points and times: the frame's, and the next one's (stage_next)
   DeviceBuffer<Eigen::Vector3f> frame_;  // the kept points (sensor frame, scan end)
   DeviceBuffer<Eigen::Vector3f> world_;
   DeviceBuffer<Eigen::Vector4f> source_points_;
   DeviceBuffer<map::Cov3> source_covs_;
   DeviceBuffer<registration::Correspondence> matches_;  // each source point's last search
   DeviceBuffer<std::int32_t> dropped_;                  // non-finite points of the last scan
-  StagedUpload staging_;                                // the scan's way to the device
   std::size_t frame_size_ = 0;
   std::size_t source_size_ = 0;
   std::size_t map_points_ = 0;  // in the submap after the last update (read back with it)
