@@ -72,8 +72,8 @@ class ScanSlots {
   ScanSlots& operator=(const ScanSlots&) = delete;
 
   /// Starts moving `next` into a slot and returns at once (the host's part runs on the worker).
-  /// `next` must stay alive and unchanged until the next take() or stage(). A scan beyond the
-  /// slots' size is not staged (take() then says so).
+  /// `next` must stay alive and unchanged until take() of it, the next stage() or the
+  /// destructor. A scan beyond the slots' size is not staged (take() then says so).
   void stage(const Scan& next);
   /// `scan` on the device, on the frame stream's timeline: its slot when it was staged (the same
   /// object, unchanged), else uploaded now. The times go up when `times`.

@@ -37,11 +37,11 @@ class ScanBackend {
   /// Empties both maps and takes the map parameters of `config` (the voxel size is fixed at the
   /// first scan). Allocates nothing on the CUDA backend.
   virtual void reset(const Config& config) = 0;
-  /// The scan that the next preprocess() will be given, handed over before the current frame's
-  /// stages: a backend may start moving it towards its device while it works on the current one
-  /// (the CUDA backend uploads it on a stream of its own; the CPU backend has nothing to move).
-  /// `next` must stay alive and unchanged until the next preprocess() or stage_next(); a scan
-  /// other than the staged one is preprocessed as usual.
+  /// The scan after the one the next preprocess() will be given, handed over before that frame's
+  /// stages: a backend may start moving it towards its device while it works on the frame (the
+  /// CUDA backend uploads it on a stream of its own; the CPU backend has nothing to move). `next`
+  /// must stay alive and unchanged until its own preprocess(), the next stage_next() or the
+  /// backend's end; a scan other than the staged one is preprocessed as usual.
   virtual void stage_next(const Scan& next) { (void)next; }
   /// Whether the last preprocess() found its scan staged by stage_next (already on its way).
   [[nodiscard]] virtual bool last_scan_was_staged() const { return false; }

@@ -88,8 +88,9 @@ class ScanPipeline {
   /// The scan that process() will be given after the next one, so that the backend can move it
   /// towards its device while it works (the CUDA backend uploads it during the next frame's
   /// kernels: offline, scans back to back, the upload leaves the frame's time). `next` must stay
-  /// alive and unchanged until process() of it; a scan other than the staged one (or one the
-  /// pipeline screens first) is uploaded in its own frame, as without staging.
+  /// alive and unchanged until process() of it, the next stage_next() or the pipeline's end; a
+  /// scan other than the staged one (or one the pipeline screens first) is uploaded in its own
+  /// frame, as without staging.
   void stage_next(const Scan& next) { backend_->stage_next(next); }
 
   /// Replaces the initial pose; only before the first scan (throws std::logic_error after).
