@@ -7,7 +7,8 @@
 // On the GPU each sequence runs twice: with each scan uploaded in its own frame (a live scan's
 // latency), and with the next scan staged before each frame (ScanPipeline::stage_next: offline,
 // scans back to back, its upload overlaps the frame's kernels); the row "NAME+next" is the second,
-// its dt_max / dr_max the largest pose difference to the first (0: the same results).
+// its dt_max / dr_max the largest pose difference to the first (0: the same results), followed by
+// how many of its scans the backend found staged (all but the first, or the staging did nothing).
 // Usage: gpu_pipeline [--frames N] [--profile urban|racetrack|handheld|tunnel]... [--scans DIR]...
 //                     [--device cuda|cpu|auto] [--no-cpu-compare] [--no-staged] [--repeats R]
 // --no-staged: without the run with the next scan staged.
@@ -139,6 +140,7 @@ struct Run {
   double prealloc_bytes = 0.0, used_bytes = 0.0;
   std::size_t max_voxels = 0;
   bool device_timed = false;
+  std::size_t found_staged = 0;  // frames whose scan the backend found staged
 };
 
 /// `stage_next`: the next scan is handed to the pipeline before each frame (in the frame's time).
@@ -149,6 +151,7 @@ Run run(pipeline::ScanPipeline& p, const std::vector<Scan>& scans, double used_b
     const auto t0 = std::chrono::steady_clock::now();
     if (stage_next && i + 1 < scans.size()) p.stage_next(scans[i + 1]);
     const auto f = p.process(s);
+    r.found_staged += p.backend().last_scan_was_staged() ? 1 : 0;
     r.total_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     const double st[kStages] = {f.timings.preprocess_s, f.timings.covariance_s, f.timings.registration_s,
                                 f.timings.map_update_s};
@@ -247,6 +250,7 @@ int main(int argc, char** argv) {
           dr = std::max(dr, d.angle_rad() * 180.0 / M_PI);
         }
         print_row(name + "+next", points, staged.backend().device(), rs, dt, dr);
+        std::printf("    scans found staged: %zu of %zu\n", rs.found_staged, scans.size());
       }
       print_bandwidth(p, o.repeats, quantile(r.total_ms, kMedian));
     }
