@@ -70,6 +70,16 @@ inline Recording record(sim::Profile profile, double duration_s, std::size_t kee
   return r;
 }
 
+/// Scans [first, first + count) of a profile's generated sequence, whole, with its own LiDAR.
+inline std::vector<Scan> generated_scans(sim::Profile profile, std::size_t first, std::size_t count) {
+  sim::SimConfig cfg = sim::default_config(profile);
+  cfg.duration_s = static_cast<double>(first + count + 1) / cfg.lidar_rate_hz;
+  const sim::SequenceGenerator gen(cfg);
+  std::vector<Scan> scans;
+  for (std::size_t i = first; i < first + count; ++i) scans.push_back(gen.scan(i));
+  return scans;
+}
+
 /// How far a run's body position at the last scan is from the truth, both taken relative to the
 /// first scan (the run's own start and the recording's): the end drift of the motion estimated.
 inline double final_position_error_m(const Recording& rec, const SE3& first_body, const SE3& last_body) {

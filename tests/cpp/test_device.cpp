@@ -6,7 +6,7 @@
 #include "farlio/core/device.hpp"
 #include "farlio/pipeline/backend_availability.hpp"
 #include "farlio/pipeline/scan_pipeline.hpp"
-#include "farlio/sim/sequence_generator.hpp"
+#include "sim_recording.hpp"
 
 using namespace farlio;
 
@@ -66,11 +66,7 @@ TEST(Device, CudaWithoutAGpuIsAClearError) {
 TEST(Device, OnTheCpuAStagedScanChangesNothing) {
   // the CPU backend has nothing to move: staging the next scan leaves every result as it was
   constexpr std::size_t kFirst = 25, kScans = 5;  // generated urban starts with 2.5 s at rest
-  sim::SimConfig sc = sim::default_config(sim::Profile::Urban);
-  sc.duration_s = 0.1 * static_cast<double>(kFirst + kScans + 1);
-  const sim::SequenceGenerator gen(sc);
-  std::vector<Scan> scans;
-  for (std::size_t i = kFirst; i < kFirst + kScans; ++i) scans.push_back(gen.scan(i));
+  const std::vector<Scan> scans = test::generated_scans(sim::Profile::Urban, kFirst, kScans);
   Config c;
   c.device = Device::Cpu;
   c.registration.time_budget_factor = 1e6;  // compare results, not the time budget

@@ -182,11 +182,7 @@ TEST(CudaPipeline, ScansStagedBackToBackGiveTheSameBitsAsScansUploadedInTheirFra
   // kernels; every scan after the first must be found staged, and nothing may change
   FARLIO_REQUIRE_GPU();
   constexpr std::size_t kStagedFrames = 12;
-  sim::SimConfig sc = sim::default_config(sim::Profile::Urban);
-  sc.duration_s = 0.1 * static_cast<double>(kSkipAtRest + kStagedFrames + 1);
-  const sim::SequenceGenerator gen(sc);
-  std::vector<Scan> scans;
-  for (std::size_t i = kSkipAtRest; i < kSkipAtRest + kStagedFrames; ++i) scans.push_back(gen.scan(i));
+  const std::vector<Scan> scans = test::generated_scans(sim::Profile::Urban, kSkipAtRest, kStagedFrames);
   pipeline::ScanPipeline plain(config_on(Device::Cuda)), staged(config_on(Device::Cuda));
   for (std::size_t i = 0; i < scans.size(); ++i) {
     SCOPED_TRACE("frame " + std::to_string(i));
@@ -207,11 +203,7 @@ TEST(CudaPipeline, AScanOtherThanTheStagedOnesIsUploadedInItsFrame) {
   // found staged only when the object itself was staged and is still held
   FARLIO_REQUIRE_GPU();
   constexpr std::size_t kScans = 8;
-  sim::SimConfig sc = sim::default_config(sim::Profile::Urban);
-  sc.duration_s = 0.1 * static_cast<double>(kSkipAtRest + kScans + 1);
-  const sim::SequenceGenerator gen(sc);
-  std::vector<Scan> s;
-  for (std::size_t i = kSkipAtRest; i < kSkipAtRest + kScans; ++i) s.push_back(gen.scan(i));
+  const std::vector<Scan> s = test::generated_scans(sim::Profile::Urban, kSkipAtRest, kScans);
   pipeline::ScanPipeline plain(config_on(Device::Cuda)), staged(config_on(Device::Cuda));
   const auto step = [&](std::size_t k, bool expect_staged) {
     SCOPED_TRACE("scan " + std::to_string(k));
