@@ -84,7 +84,7 @@ class CudaScanBackend final : public pipeline::ScanBackend {
     // the times go up whenever the scan has them: a point with a non-finite time is dropped too
     const bool times = scan.has_time();
     upload_bytes_ = n * (sizeof(Eigen::Vector3f) + (times ? sizeof(float) : 0));
-    const ScanSlots::Slot slot = scans_.take(scan, times);  // staged by stage_next, or uploaded now
+    const ScanSlots::Slot slot = scans_.take(scan);  // staged by stage_next, or uploaded now
     non_finite_points_ = 0;
     frame_size_ = n == 0
                       ? 0

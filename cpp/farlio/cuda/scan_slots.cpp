@@ -107,12 +107,12 @@ int ScanSlots::free_slot() {
   return older;
 }
 
-void ScanSlots::upload(const Scan& scan, bool times, int slot, StagedUpload& staging, cudaStream_t stream) {
+void ScanSlots::upload(const Scan& scan, int slot, StagedUpload& staging, cudaStream_t stream) {
   const std::size_t n = scan.size();
   points_[slot].require(n, kScanParameter);
   staging.begin_frame();
   staging.upload(scan.points.data(), points_[slot].data(), n * sizeof(Eigen::Vector3f), stream);
-  if (times) staging.upload(scan.time_s.data(), times_[slot].data(), n * sizeof(float), stream);
+  if (scan.has_time()) staging.upload(scan.time_s.data(), times_[slot].data(), n * sizeof(float), stream);
 }
 
 void ScanSlots::finish_job() {
@@ -134,18 +134,18 @@ void ScanSlots::stage(const Scan& next) {
   FARLIO_CUDA_CHECK(cudaStreamWaitEvent(copy_stream_, frame_queued_, 0));
   worker_.start([this, &next, slot] {
     FARLIO_CUDA_CHECK(cudaSetDevice(device_));  // a thread's current device is its own
-    upload(next, next.has_time(), slot, next_staging_, copy_stream_);
+    upload(next, slot, next_staging_, copy_stream_);
     FARLIO_CUDA_CHECK(cudaEventRecord(staged_ready_[slot], copy_stream_));
   });
 }
 
-ScanSlots::Slot ScanSlots::take(const Scan& scan, bool times) {
+ScanSlots::Slot ScanSlots::take(const Scan& scan) {
   // Scans back to back: the worker is busy with the next scan, staged into the other slot while
   // this one's copy has long been queued; the frame waits for the worker only for the slot the
   // worker writes into.
   const Identity id = Identity::of(scan);
   for (int s = 0; s < kSlots; ++s) {
-    if (staged_[s] && staged_scan_[s] == id && times == scan.has_time()) {
+    if (staged_[s] && staged_scan_[s] == id) {
       if (s == job_slot_) finish_job();  // its copy is queued once the job is done
       staged_[s] = false;
       current_ = s;
@@ -159,7 +159,7 @@ ScanSlots::Slot ScanSlots::take(const Scan& scan, bool times) {
   if (current_ == job_slot_) finish_job();  // a staged scan dropped: its copies are queued
   // a staged copy that was dropped may still be writing into the slot
   FARLIO_CUDA_CHECK(cudaStreamWaitEvent(frame_stream_, staged_ready_[current_], 0));
-  upload(scan, times, current_, frame_staging_, frame_stream_);
+  upload(scan, current_, frame_staging_, frame_stream_);
   return slot(current_);
 }
 

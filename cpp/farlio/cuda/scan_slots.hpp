@@ -76,8 +76,8 @@ class ScanSlots {
   /// destructor. A scan beyond the slots' size is not staged (take() then says so).
   void stage(const Scan& next);
   /// `scan` on the device, on the frame stream's timeline: its slot when it was staged (the same
-  /// object, unchanged), else uploaded now. The times go up when `times`.
-  Slot take(const Scan& scan, bool times);
+  /// object, unchanged), else uploaded now. Its times go up when it has them, staged or not.
+  Slot take(const Scan& scan);
 
   /// Whether the last take() found its scan staged.
   [[nodiscard]] bool last_was_staged() const { return last_staged_; }
@@ -101,8 +101,9 @@ class ScanSlots {
   int free_slot();
   /// Waits for the worker's job (its copies are then queued) and rethrows what it threw.
   void finish_job();
-  /// Queues the copy of `scan`'s arrays into `slot` through `staging` on `stream`.
-  void upload(const Scan& scan, bool times, int slot, StagedUpload& staging, cudaStream_t stream);
+  /// Queues the copy of `scan`'s points, and its times when it has them, into `slot` through
+  /// `staging` on `stream`.
+  void upload(const Scan& scan, int slot, StagedUpload& staging, cudaStream_t stream);
   [[nodiscard]] Slot slot(int s) const { return {points_[s].data(), times_[s].data()}; }
 
   static constexpr int kSlots = 2;
