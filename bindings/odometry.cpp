@@ -128,6 +128,9 @@ void bind_fusion_stats(nb::module_& m) {
       .def_ro("measured_accel_step_std_m_s2", &fusion::FusionStats::measured_accel_step_std_m_s2,
               "the accelerometer's noise measured on its samples, averaged over a filter step")
       .def_ro("imu_rate_hz", &fusion::FusionStats::imu_rate_hz, "the IMU's sample rate (0 before the first estimate)")
+      .def_ro("deskew_gyro_weight", &fusion::FusionStats::deskew_gyro_weight,
+              "the gyro's mean weight in the rotation rate that undistorts the scans, per LiDAR axis "
+              "(1: the gyro's rate, 0: the LiDAR's constant twist)")
       .def_ro("lidar_innovation", &fusion::FusionStats::lidar_innovation,
               "the LiDAR groups' normalised innovations, one InnovationStats per group fused")
       .def("__repr__", attribute_repr({"steps", "lidar_groups_accepted", "lidar_groups_rejected", "reinitializations",

@@ -453,6 +453,9 @@ def _fusion_summary(stats: Any, config: Any) -> dict[str, Any]:
             "accel_step_std_m_s2": stats.measured_accel_step_std_m_s2,
             "gyro_input_std_rad_s": config.get("fusion.gyro_input_std_rad_s"),
             "accel_input_std_m_s2": config.get("fusion.accel_input_std_m_s2"),
+            # the gyro's mean weight in the rotation rate that undistorts the scans, per LiDAR axis
+            # (1: the gyro's rate, 0: the LiDAR's constant twist): the two blended by their errors
+            "deskew_gyro_weight": list(stats.deskew_gyro_weight),
         },
         # the LiDAR updates' normalised innovations squared (NIS) per degree of freedom: 1 and 5 %
         # beyond the chi-squared 95 % quantile when the filter's noise fits the data

@@ -66,6 +66,10 @@ struct FusionStats {
   double measured_gyro_step_std_rad_s = 0.0;
   double measured_accel_step_std_m_s2 = 0.0;
   double imu_rate_hz = 0.0;
+  /// The gyro's mean weight in the rotation rate that undistorts the scans, per LiDAR axis
+  /// (deskew/rotation_rate_blend.hpp): 1 where the gyro's rate is used as measured, 0 where the
+  /// LiDAR's constant twist; set by the driver that undistorts (pipeline/fusion_driver.hpp).
+  Eigen::Vector3d deskew_gyro_weight = Eigen::Vector3d::Ones();
   /// The LiDAR updates' normalised innovations (innovation_stats.hpp), one entry per group fused:
   /// the pose (with the registration's covariance) or the position and orientation (the fixed
   /// noise), and the velocity.
@@ -120,6 +124,8 @@ class SensorFusion {
   /// The filter's input noise over a step [accel (m/s^2), gyro (rad/s)]: the configured stds, or
   /// the IMU's noise measured on its samples where larger (imu_noise.hpp).
   [[nodiscard]] InputVector input_std() const { return ekf_.input_variance().cwiseSqrt(); }
+  /// The IMU's noise measured on its samples (imu_noise.hpp); nullopt before the first estimate.
+  [[nodiscard]] const std::optional<ImuNoise>& measured_imu_noise() const { return imu_noise_.noise(); }
   /// The filter step (FusionConfig::step_s) in ns.
   [[nodiscard]] std::int64_t step_ns() const { return step_ns_; }
   /// The filter's time: its newest step (valid once initialised).

@@ -46,6 +46,28 @@ std::optional<deskew::ScanMotion> motion_from_fusion(const fusion::SensorFusion&
   return deskew::fit_scan_motion(samples, end_pose);
 }
 
+/// The gyro's rotation over the scan as a line in the undistortion's tangent space (LiDAR frame),
+/// before the filter runs: offset and rate of the least-squares line through the integrated gyro
+/// at kMotionSamples instants, as motion_from_fusion fits the fusion's poses (a line through the
+/// scan's end points alone errs more where the rotation accelerates: a walker looking around).
+struct RotationLine {
+  Eigen::Vector3d offset = Eigen::Vector3d::Zero();
+  Eigen::Vector3d rate = Eigen::Vector3d::Zero();
+};
+std::optional<RotationLine> gyro_rotation_line(const fusion::SensorFusion& fusion, const Scan& scan,
+                                               const Mat3d& R_il) {
+  if (!scan.has_time() || scan.duration_s() <= 0.0) return std::nullopt;
+  std::vector<std::pair<double, SE3>> samples{{0.0, SE3()}};
+  for (int i = 1; i < kMotionSamples; ++i) {
+    const double tau = scan.duration_s() * i / (kMotionSamples - 1);
+    const auto body = fusion.imu_rotation(scan.start_stamp_ns, scan.start_stamp_ns + seconds_to_ns(tau));
+    if (!body) return std::nullopt;
+    samples.emplace_back(tau, SE3(R_il.transpose() * *body * R_il, Eigen::Vector3d::Zero()));
+  }
+  const deskew::ScanMotion line = deskew::fit_scan_motion(samples, samples.back().second);
+  return RotationLine{line.offset.tail<3>().cast<double>(), line.rate.tail<3>().cast<double>()};
+}
+
 bool in_gravity_window(const ImuSample& first, const ImuSample& s) {
   return s.stamp_ns - first.stamp_ns <= seconds_to_ns(kGravityAlignmentWindow_s);
 }
@@ -294,7 +316,7 @@ SE3 FusionDriver::start_pose(std::int64_t first_scan_end_ns, const std::optional
   return SE3(fusion::rotation_from_euler(rpy), requested->translation());
 }
 
-ScanPrior FusionDriver::prior(const Scan& scan, const registration::Vec6d& lidar_twist) const {
+ScanPrior FusionDriver::prior(const Scan& scan, const registration::Vec6d& lidar_twist, bool twist_measured) {
   ScanPrior prior;
   if (!fusion_) return prior;
   if (fusion_->initialized()) {
@@ -307,6 +329,7 @@ ScanPrior FusionDriver::prior(const Scan& scan, const registration::Vec6d& lidar
     if (const auto body = fusion_->pose_at(scan.end_stamp_ns)) {
       prior.guess = *body * T_imu_lidar_;
       prior.motion = motion_from_fusion(*fusion_, scan, *prior.guess, T_imu_lidar_);
+      if (prior.motion && twist_measured) blend_rotation_rate(scan, lidar_twist, *prior.motion);
       prior.fused = true;
       prior.confirmed = gyro_unit_.decided() && gyro_unit_.unit() != fusion::GyroUnit::kStuck;
     }
@@ -331,8 +354,37 @@ ScanPrior FusionDriver::prior(const Scan& scan, const registration::Vec6d& lidar
     registration::Vec6d twist;
     twist << lidar_twist.head<3>(), lidar_rotation_vector(*during_scan) / scan.duration_s();
     prior.motion = deskew::ScanMotion::constant_twist(twist.cast<float>(), static_cast<float>(scan.duration_s()));
+    if (twist_measured) blend_rotation_rate(scan, lidar_twist, *prior.motion);
   }
   return prior;
+}
+
+void FusionDriver::blend_rotation_rate(const Scan& scan, const registration::Vec6d& lidar_twist,
+                                       deskew::ScanMotion& motion) {
+  // the gyro's side: the fusion's motion over the scan once the filter runs; before, the gyro's line
+  RotationLine gyro{motion.offset.tail<3>().cast<double>(), motion.rate.tail<3>().cast<double>()};
+  if (!fusion_->initialized()) {
+    const auto line = gyro_rotation_line(*fusion_, scan, T_imu_lidar_.rotation());
+    if (!line) return;
+    gyro = *line;
+  }
+  // the gyro's error over the scan in the LiDAR frame (per axis: the diagonal of R^T S R)
+  std::optional<Eigen::Vector3d> gyro_variance;
+  if (const auto& noise = fusion_->measured_imu_noise()) {
+    const Mat3d R_il = T_imu_lidar_.rotation();
+    const Eigen::Vector3d body = noise->gyro_step_std_rad_s(scan.duration_s()).cwiseAbs2();
+    gyro_variance = (R_il.transpose() * body.asDiagonal() * R_il).diagonal();
+  }
+  const Eigen::Vector3d twist_rate = lidar_twist.tail<3>();
+  const Eigen::Vector3d rate = rotation_rate_blend_.blend(gyro.rate, twist_rate, gyro_variance, scan.end_stamp_ns);
+  const Eigen::Vector3d w = rotation_rate_blend_.gyro_weight();
+  // the lines xi(tau) = offset + rate tau blended as a whole: the constant twist's offset is -D w
+  const Eigen::Vector3d offset =
+      w.cwiseProduct(gyro.offset) + (Eigen::Vector3d::Ones() - w).cwiseProduct(-scan.duration_s() * twist_rate);
+  motion.rate.tail<3>() = rate.cast<float>();
+  motion.offset.tail<3>() = offset.cast<float>();
+  gyro_weight_sum_ += w;
+  ++blended_scans_;
 }
 
 bool FusionDriver::held_at_prior(const OdometryFrame& frame) const {
@@ -495,7 +547,9 @@ void FusionDriver::link(const Scan& scan, OdometryFrame& frame) {
 
 std::optional<fusion::FusionStats> FusionDriver::stats() const {
   if (!fusion_) return std::nullopt;
-  return fusion_->stats();
+  fusion::FusionStats s = fusion_->stats();
+  if (blended_scans_ > 0) s.deskew_gyro_weight = gyro_weight_sum_ / static_cast<double>(blended_scans_);
+  return s;
 }
 
 }  // namespace farlio::pipeline

@@ -46,6 +46,7 @@
 #include "farlio/core/se3.hpp"
 #include "farlio/core/trajectory.hpp"
 #include "farlio/core/types.hpp"
+#include "farlio/deskew/rotation_rate_blend.hpp"
 #include "farlio/deskew/scan_motion.hpp"
 #include "farlio/fusion/gyro_unit_detector.hpp"
 #include "farlio/fusion/sensor_fusion.hpp"
@@ -135,8 +136,10 @@ class FusionDriver {
 
   /// The initial guess and the motion during the scan (ScanPrior); lidar_twist: the scan
   /// pipeline's constant-velocity twist (ScanPipeline::last_twist), for the translation before
-  /// the filter is initialised.
-  [[nodiscard]] ScanPrior prior(const Scan& scan, const registration::Vec6d& lidar_twist) const;
+  /// the filter is initialised and, once measured (twist_measured: two scans registered), for the
+  /// rotation rate of the undistortion, blended with the gyro's by their errors
+  /// (deskew/rotation_rate_blend.hpp).
+  [[nodiscard]] ScanPrior prior(const Scan& scan, const registration::Vec6d& lidar_twist, bool twist_measured);
   /// After the scan pipeline (frame.scan and frame.body_pose set): sets frame.drop_reason and
   /// frame.degeneracy and, unless dropped and when inertial, fuses the result at the current clock
   /// (frame.fused).
@@ -162,6 +165,10 @@ class FusionDriver {
   void jump_clock(const ImuSample& sample);
   /// After the gyro unit was decided: scales and restarts, or ends the fusion.
   void apply_gyro_unit();
+  /// The rotation part of `motion` (the fusion's over the scan; before the filter, the gyro's
+  /// least-squares line) blended with lidar_twist's by their errors (unchanged before the filter
+  /// across an IMU gap).
+  void blend_rotation_rate(const Scan& scan, const registration::Vec6d& lidar_twist, deskew::ScanMotion& motion);
   /// Whether the registration held the frame's degenerate directions at the fusion's prior.
   [[nodiscard]] bool held_at_prior(const OdometryFrame& frame) const;
   /// The registration's pose covariance in the body frame (its degenerate rotation axes released
@@ -213,6 +220,9 @@ class FusionDriver {
   bool gyro_turn_confirmed_ = false;  ///< a clear turn agreed with the gyro, and no interval since disagreed
   bool warned_undecided_gyro_ = false;
   std::optional<std::int64_t> first_degenerate_start_ns_;  ///< the first degenerate scan before the filter
+  deskew::RotationRateBlend rotation_rate_blend_;
+  Eigen::Vector3d gyro_weight_sum_ = Eigen::Vector3d::Zero();  ///< over the blended scans, for stats()
+  std::int64_t blended_scans_ = 0;
   bool warned_degenerate_start_ = false;
   std::int64_t clock_ns_ = 0;
   std::int64_t next_output_ns_ = 0;  ///< 0: set by the first IMU sample

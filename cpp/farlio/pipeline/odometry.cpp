@@ -141,7 +141,7 @@ OdometryFrame Odometry::process(const Scan& scan) {
     pipeline_.reset_initial_pose(initial_body_pose_ * T_imu_lidar_);
   }
 
-  const ScanPrior prior = driver_.prior(scan, pipeline_.last_twist());
+  const ScanPrior prior = driver_.prior(scan, pipeline_.last_twist(), pipeline_.frames() >= 2);
   register_from_prior(pipeline_, scan, prior, T_lidar_imu_, out);
   out.available_ns = out.started_ns + seconds_to_ns(latency_s(out.scan));
   busy_until_ns_ = out.available_ns;

@@ -126,7 +126,7 @@ OdometryFrame OnlineOdometry::process(const Scan& scan) {
       started_ = true;
       pipeline_.reset_initial_pose(driver_.start_pose(scan.end_stamp_ns, requested_initial_pose_) * T_imu_lidar_);
     }
-    prior = driver_.prior(scan, pipeline_.last_twist());
+    prior = driver_.prior(scan, pipeline_.last_twist(), pipeline_.frames() >= 2);
     out.started_ns = fused_clock() ? driver_.clock_ns() : scan.end_stamp_ns;
   }
   register_from_prior(pipeline_, scan, prior, T_lidar_imu_, out);
