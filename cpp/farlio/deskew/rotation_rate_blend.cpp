@@ -22,9 +22,10 @@ Eigen::Vector3d RotationRateBlend::blend(const Eigen::Vector3d& gyro_rate, const
   }
   const double forget = std::clamp(ns_to_seconds(stamp_ns - last_stamp_ns_) / kMemory_s, 0.0, 1.0);
   last_stamp_ns_ = stamp_ns;
-  disagreement_variance_ =
-      disagreement_variance_ ? Eigen::Vector3d(*disagreement_variance_ + forget * (disagreement - *disagreement_variance_))
-                             : disagreement;
+  if (disagreement_variance_)
+    *disagreement_variance_ += forget * (disagreement - *disagreement_variance_);
+  else
+    disagreement_variance_ = disagreement;
   return gyro_weight_.cwiseProduct(gyro_rate) + (Eigen::Vector3d::Ones() - gyro_weight_).cwiseProduct(twist_rate);
 }
 
