@@ -320,3 +320,33 @@ TEST(FusionSensor, ChiSquaredQuantilesHoldForGaussianInnovations) {
   EXPECT_EQ(fusion::chi2_95(0), 0.0);
   EXPECT_EQ(fusion::chi2_95(7), 0.0);
 }
+
+TEST(FusionSensor, PosesJitteringWithinTheirRestJitterStartTheFilterStanding) {
+  // a body at rest, its LiDAR poses jittering 3 cm and 0.3 deg from scan to scan at 20 Hz (a
+  // degenerate narrow field of view standing): beyond the usual 2 cm they read as motion and the
+  // filter waits for an in-motion window; with the scans' own stds as their rest jitter it starts
+  // at rest from the second
+  for (const bool with_jitter : {false, true}) {
+    fusion::SensorFusion f(FusionConfig{}, kGravity_m_s2);
+    for (std::int64_t t = 0; t <= seconds_to_ns(0.3); t += seconds_to_ns(0.005)) {
+      f.add_imu({t, Eigen::Vector3d::Zero(), Eigen::Vector3d(0.0, 0.0, kGravity_m_s2)});
+    }
+    f.advance_to(seconds_to_ns(0.3));
+    bool started = false;
+    for (int k = 1; k <= 5 && !started; ++k) {
+      const double s = (k % 2 == 0) ? 1.0 : -1.0;
+      const SE3 pose(Eigen::Quaterniond(Eigen::AngleAxisd(s * 0.0026, Eigen::Vector3d::UnitZ())),
+                     Eigen::Vector3d(s * 0.015, 0.0, 0.0));
+      const fusion::RestJitter jitter = with_jitter ? fusion::RestJitter{0.1, 0.006} : fusion::RestJitter{};
+      started =
+          f.add_lidar(seconds_to_ns(0.05 * k), pose, Eigen::Vector3d::Zero(), false, std::nullopt, std::nullopt, jitter)
+              .initialized_filter;
+    }
+    EXPECT_EQ(started, with_jitter);
+    if (with_jitter) {
+      EXPECT_EQ(f.stats().initialization.mode, "standstill");
+      EXPECT_EQ(f.stats().initialization.window_poses, 2);
+      EXPECT_LT(f.estimate().velocity_body_m_s.norm(), 0.05);
+    }
+  }
+}

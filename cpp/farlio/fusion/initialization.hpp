@@ -29,6 +29,10 @@ namespace farlio::fusion {
 struct WindowPose {
   std::int64_t stamp_ns = 0;
   SE3 body_pose;
+  /// How far the LiDAR's pose jitters at rest beyond the usual (m, rad): a degenerate scan's own
+  /// stds, which the driver passes only where the IMU too reads rest (FusionDriver); 0 otherwise.
+  double rest_jitter_m = 0.0;
+  double rest_jitter_rad = 0.0;
 };
 
 /// The IMU over [start_ns, end_ns] as the alignment reads it: the mean specific force (m/s^2) and

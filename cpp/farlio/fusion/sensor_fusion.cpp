@@ -16,9 +16,6 @@ constexpr std::size_t kExtraHistoryEntries = 2;  ///< both ends of the history s
 /// In motion, the LiDAR results the alignment needs at least (two equations a pair, six unknowns
 /// a pose: three poses make it overdetermined).
 constexpr std::size_t kMinPosesInMotion = 3;
-/// The LiDAR poses of a body at rest move by up to this between two scans (registration noise):
-/// a window whose results move less shows rest whatever the scan rate.
-constexpr double kRestPositionJitter_m = 0.02;
 /// The zero-velocity prior of a window that shows the body at rest (m/s): tight, so that gravity
 /// follows from the specific force as in levelling.
 constexpr double kRestVelocityStd_m_s = 0.01;
@@ -251,7 +248,7 @@ void SensorFusion::initialize_known(std::int64_t stamp_ns, const SE3& body_pose,
   level_from_map_ = Eigen::Matrix3d::Identity();
   initialize(stamp_ns, body_pose, velocity_body_m_s, config_.lidar_velocity_std_m_s, 0.0);
   last_lidar_ns_ = stamp_ns;
-  add_to_window(stamp_ns, body_pose);
+  add_to_window(stamp_ns, body_pose, {});
   InitializationReport& report = stats_.initialization;
   report = InitializationReport{};
   report.initialized = true;
@@ -274,11 +271,11 @@ SE3 SensorFusion::to_map(const SE3& level_pose) const {
   return {R * level_pose.rotation(), R * level_pose.translation()};
 }
 
-void SensorFusion::add_to_window(std::int64_t stamp_ns, const SE3& body_pose) {
+void SensorFusion::add_to_window(std::int64_t stamp_ns, const SE3& body_pose, const RestJitter& rest_jitter) {
   if (!window_.empty() && stamp_ns <= window_.back().stamp_ns) return;
   const auto span_s = [&](const WindowPose& from) { return ns_to_seconds(stamp_ns - from.stamp_ns); };
   if (!window_.empty() && span_s(window_.back()) > config_.init.window_s) window_.clear();  // an outage
-  window_.push_back({stamp_ns, body_pose});
+  window_.push_back({stamp_ns, body_pose, rest_jitter.translation_m, rest_jitter.rotation_rad});
   // the shortest run of the newest results that spans fusion.init.window_s
   while (window_.size() > 2 && span_s(window_[1]) >= config_.init.window_s) window_.erase(window_.begin());
 }
@@ -304,8 +301,10 @@ bool SensorFusion::window_at_rest() const {
   for (std::size_t k = 1; k < window_.size(); ++k) {
     const double dt_s = ns_to_seconds(window_[k].stamp_ns - window_[k - 1].stamp_ns);
     const SE3 motion = window_[k - 1].body_pose.inverse() * window_[k].body_pose;
-    if (motion.translation().norm() > std::max(config_.standstill.max_speed_m_s * dt_s, kRestPositionJitter_m) ||
-        motion.angle_rad() > config_.standstill.max_gyro_rad_s * dt_s)
+    const double jitter_m = std::max({kRestPositionJitter_m, window_[k - 1].rest_jitter_m, window_[k].rest_jitter_m});
+    const double jitter_rad = std::max(window_[k - 1].rest_jitter_rad, window_[k].rest_jitter_rad);
+    if (motion.translation().norm() > std::max(config_.standstill.max_speed_m_s * dt_s, jitter_m) ||
+        motion.angle_rad() > std::max(config_.standstill.max_gyro_rad_s * dt_s, jitter_rad))
       return false;
   }
   return window_.size() >= 2;
@@ -365,9 +364,10 @@ int SensorFusion::spread_steps(std::int64_t measured_at_ns) const {
 LidarUpdateResult SensorFusion::add_lidar(std::int64_t measured_at_ns, const SE3& map_pose,
                                           const Eigen::Vector3d& body_velocity_m_s, bool use_velocity,
                                           const std::optional<Mat6d>& body_covariance,
-                                          const std::optional<Eigen::Matrix3d>& velocity_covariance) {
+                                          const std::optional<Eigen::Matrix3d>& velocity_covariance,
+                                          const RestJitter& rest_jitter) {
   LidarUpdateResult result;
-  add_to_window(measured_at_ns, map_pose);
+  add_to_window(measured_at_ns, map_pose, rest_jitter);
   if (!initialized()) {
     result.initialized_filter = initialize_from_window();
     last_lidar_ns_ = measured_at_ns;

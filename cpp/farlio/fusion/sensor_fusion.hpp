@@ -85,6 +85,18 @@ struct LidarUpdateResult {
   std::string rejection_reason;     ///< set when the whole result was rejected
 };
 
+/// The LiDAR poses of a body at rest move by up to this between two scans (registration noise):
+/// a window whose results move less shows rest whatever the scan rate.
+inline constexpr double kRestPositionJitter_m = 0.02;
+
+/// A pose's jitter at rest beyond the LiDAR's usual 2 cm (add_lidar): a degenerate scan's own
+/// stds along its worst translation and rotation, which the caller passes only where the IMU reads
+/// rest too (a narrow field of view standing: FusionDriver).
+struct RestJitter {
+  double translation_m = 0.0;
+  double rotation_rad = 0.0;
+};
+
 class SensorFusion {
  public:
   /// `known`: what an earlier filter of the same run found of the map frame (its gravity, its
@@ -107,7 +119,8 @@ class SensorFusion {
   LidarUpdateResult add_lidar(std::int64_t measured_at_ns, const SE3& map_pose,
                               const Eigen::Vector3d& body_velocity_m_s, bool use_velocity,
                               const std::optional<Mat6d>& body_covariance = std::nullopt,
-                              const std::optional<Eigen::Matrix3d>& velocity_covariance = std::nullopt);
+                              const std::optional<Eigen::Matrix3d>& velocity_covariance = std::nullopt,
+                              const RestJitter& rest_jitter = {});
 
   /// Starts the filter from a known state instead (another navigation system, a test): the body
   /// pose in a level map frame at stamp_ns and its velocity; the next LiDAR results update it.
@@ -139,6 +152,9 @@ class SensorFusion {
   /// The body's rotation from start_ns to end_ns as the gyro integrates it (biases removed);
   /// nullopt where the IMU kept does not cover the interval or has a gap there.
   [[nodiscard]] std::optional<Eigen::Matrix3d> imu_rotation(std::int64_t start_ns, std::int64_t end_ns) const;
+  /// The mean IMU input over [start_ns, end_ns] with the biases removed (the alignment's input);
+  /// nullopt where the IMU kept does not cover the interval or has a gap there.
+  [[nodiscard]] std::optional<ImuMean> imu_mean(std::int64_t start_ns, std::int64_t end_ns) const;
   /// The bias-corrected angular rate used in the last step (rad/s, body frame).
   [[nodiscard]] Eigen::Vector3d angular_velocity_body() const { return corrected_last_input().segment<3>(kGyroIndex); }
   [[nodiscard]] FusionStats stats() const;
@@ -146,15 +162,13 @@ class SensorFusion {
  private:
   /// Adds a LiDAR result to the initialisation window (the last fusion.init.window_s of results; a gap
   /// longer than that starts it again).
-  void add_to_window(std::int64_t stamp_ns, const SE3& body_pose);
+  void add_to_window(std::int64_t stamp_ns, const SE3& body_pose, const RestJitter& rest_jitter);
   /// Initialises the filter from the window when its results allow (initialization.hpp); true if it did.
   bool initialize_from_window();
   /// Whether the window's results show the body at rest (between every two, a displacement within
   /// fusion.standstill.max_speed_m_s or the LiDAR's jitter, and a rotation within
-  /// fusion.standstill.max_gyro_rad_s).
+  /// fusion.standstill.max_gyro_rad_s, each widened to the poses' RestJitter).
   [[nodiscard]] bool window_at_rest() const;
-  /// The mean IMU input over [start_ns, end_ns] with the biases removed, for the alignment.
-  [[nodiscard]] std::optional<ImuMean> imu_mean(std::int64_t start_ns, std::int64_t end_ns) const;
   /// The rotation from the filter's level frame to the map frame (the identity before gravity is known).
   [[nodiscard]] Eigen::Matrix3d map_from_level() const;
   /// A map-frame pose in the filter's level frame, and back.

@@ -30,6 +30,9 @@ constexpr double kTurnConfirmationRatio = 2.0;
 constexpr double kUndecidedGyroWarning_s = 10.0;
 /// Degenerate scans that have kept the filter from starting for this long get a warning.
 constexpr double kDegenerateStartWarning_s = 2.0;
+/// A degenerate scan stands when the IMU's mean over its interval is within the rest bounds widened
+/// by this many stds of that mean's noise.
+constexpr double kRestNoiseSigmas = 3.0;
 /// Warnings kept between two take_warnings calls; later ones are left out (a last one says so).
 constexpr std::size_t kMaxPendingWarnings = 100;
 
@@ -58,11 +61,16 @@ std::optional<RotationLine> gyro_rotation_line(const fusion::SensorFusion& fusio
                                                const Mat3d& R_il) {
   if (!scan.has_time() || scan.duration_s() <= 0.0) return std::nullopt;
   std::vector<std::pair<double, SE3>> samples{{0.0, SE3()}};
+  Mat3d body = Mat3d::Identity();  // the gyro's rotation since the scan's start, one instant to the next
+  std::int64_t previous_ns = scan.start_stamp_ns;
   for (int i = 1; i < kMotionSamples; ++i) {
     const double tau = scan.duration_s() * i / (kMotionSamples - 1);
-    const auto body = fusion.imu_rotation(scan.start_stamp_ns, scan.start_stamp_ns + seconds_to_ns(tau));
-    if (!body) return std::nullopt;
-    samples.emplace_back(tau, SE3(R_il.transpose() * *body * R_il, Eigen::Vector3d::Zero()));
+    const std::int64_t stamp_ns = scan.start_stamp_ns + seconds_to_ns(tau);
+    const auto step = fusion.imu_rotation(previous_ns, stamp_ns);
+    if (!step) return std::nullopt;
+    body = body * *step;
+    previous_ns = stamp_ns;
+    samples.emplace_back(tau, SE3(R_il.transpose() * body * R_il, Eigen::Vector3d::Zero()));
   }
   const deskew::ScanMotion line = deskew::fit_scan_motion(samples, samples.back().second);
   return RotationLine{line.offset.tail<3>().cast<double>(), line.rate.tail<3>().cast<double>()};
@@ -286,7 +294,8 @@ void FusionDriver::fuse_covered(std::int64_t horizon_ns) {
          (!fusion_->initialized() || pending_.front().stamp_ns <= fusion_->time_ns())) {
     const PendingResult r = std::move(pending_.front());
     pending_.pop_front();
-    fusion_->add_lidar(r.stamp_ns, r.body_pose, r.velocity_m_s, r.has_velocity, r.covariance, r.velocity_covariance);
+    fusion_->add_lidar(r.stamp_ns, r.body_pose, r.velocity_m_s, r.has_velocity, r.covariance, r.velocity_covariance,
+                       r.rest_jitter);
   }
 }
 
@@ -354,6 +363,7 @@ ScanPrior FusionDriver::prior(const Scan& scan, const registration::Vec6d& lidar
     registration::Vec6d twist;
     twist << lidar_twist.head<3>(), lidar_rotation_vector(*during_scan) / scan.duration_s();
     prior.motion = deskew::ScanMotion::constant_twist(twist.cast<float>(), static_cast<float>(scan.duration_s()));
+    // the gyro's chord over the scan stays where the blend cannot fit the gyro's line (an IMU gap)
     if (twist_measured) blend_rotation_rate(scan, lidar_twist, *prior.motion);
   }
   return prior;
@@ -480,10 +490,58 @@ void FusionDriver::warn_undecided_gyro(std::int64_t stamp_ns) {
   }
 }
 
-void FusionDriver::hold_start_at_degenerate_scan(std::int64_t stamp_ns, OdometryFrame& frame) {
-  if (!frame.drop_reason.empty() || !fusion_ || !has_imu() || fusion_->initialized() || !frame.degeneracy ||
-      frame.degeneracy->degenerate_translations == 0)
+bool FusionDriver::scan_stands(std::int64_t stamp_ns, const SE3& measured,
+                               const registration::Degeneracy& degeneracy) const {
+  // the scan moved within its own stds and the IMU read gravity alone, unturned: at rest, or (a
+  // degenerate scan) at a constant velocity along the direction it does not constrain
+  if (!last_body_ || stamp_ns <= last_body_->stamp_ns) return false;
+  const double dt_s = ns_to_seconds(stamp_ns - last_body_->stamp_ns);
+  const SE3 motion = last_body_->pose.inverse() * measured;
+  const double jitter_m = std::max(fusion::kRestPositionJitter_m, degeneracy.translation_std_m.maxCoeff());
+  const double jitter_rad = degeneracy.rotation_std_rad.maxCoeff();
+  if (motion.translation().norm() > std::max(fusion_config_.standstill.max_speed_m_s * dt_s, jitter_m) ||
+      motion.angle_rad() > std::max(fusion_config_.standstill.max_gyro_rad_s * dt_s, jitter_rad))
+    return false;
+  const auto mean = fusion_->imu_mean(last_body_->stamp_ns, stamp_ns);
+  if (!mean) return false;
+  double accel_std = 0.0, gyro_std = 0.0;  // of the mean over the interval, once measured
+  if (const auto& noise = fusion_->measured_imu_noise()) {
+    accel_std = noise->accel_step_std_m_s2(dt_s).norm();
+    gyro_std = noise->gyro_step_std_rad_s(dt_s).norm();
+  }
+  return std::abs(mean->accel_m_s2.norm() - gravity_m_s2_) <=
+             kLevelledStartMaxAccelDeviation_m_s2 + kRestNoiseSigmas * accel_std &&
+         mean->gyro_rad_s.norm() <= fusion_config_.standstill.max_gyro_rad_s + kRestNoiseSigmas * gyro_std;
+}
+
+bool FusionDriver::imu_within_configured_noise() const {
+  const auto& noise = fusion_->measured_imu_noise();
+  const double step_s = ns_to_seconds(fusion_->step_ns());
+  return noise && noise->gyro_step_std_rad_s(step_s).maxCoeff() <= fusion_config_.gyro_input_std_rad_s &&
+         noise->accel_step_std_m_s2(step_s).maxCoeff() <= fusion_config_.accel_input_std_m_s2;
+}
+
+void FusionDriver::hold_start_at_degenerate_scan(std::int64_t stamp_ns, const SE3& measured, OdometryFrame& frame,
+                                                 fusion::RestJitter& rest_jitter) {
+  if (!frame.drop_reason.empty() || !fusion_ || !has_imu() || fusion_->initialized() || !frame.degeneracy) {
+    rest_seen_by_constrained_scan_ = false;
     return;
+  }
+  // a degenerate scan standing enters the window once a scan that constrains every direction has
+  // shown the body at rest, and no scan since has moved or felt more than rest (coasting along
+  // parallel walls, every scan degenerate, reads as rest to every sensor on board: held)
+  const bool stands = scan_stands(stamp_ns, measured, *frame.degeneracy);
+  if (frame.degeneracy->degenerate_translations == 0) {
+    rest_seen_by_constrained_scan_ = stands;
+    return;
+  }
+  if (!stands) rest_seen_by_constrained_scan_ = false;
+  // a filter started there carries the unconstrained direction on the accelerometer: only an IMU
+  // measured within the filter's configured input noise (not a vibrating race car's) may start it
+  if (rest_seen_by_constrained_scan_ && imu_within_configured_noise()) {
+    rest_jitter = {frame.degeneracy->translation_std_m.maxCoeff(), frame.degeneracy->rotation_std_rad.maxCoeff()};
+    return;
+  }
   // a pose that stands still along a direction the scan does not constrain says nothing of the
   // velocity there (a sparse LiDAR at speed between parallel walls registers as standing): the
   // filter starts from a run of scans that constrain every direction
@@ -520,7 +578,8 @@ void FusionDriver::link(const Scan& scan, OdometryFrame& frame) {
         "not fused: the scan ends " + seconds_text(ns_to_seconds(clock_ns_) - ns_to_seconds(stamp_ns)) +
         " s before the IMU clock, beyond fusion.imu_gate.max_bridged_gap_s (do the IMU and LiDAR clocks differ?)";
   }
-  hold_start_at_degenerate_scan(stamp_ns, frame);
+  fusion::RestJitter rest_jitter;
+  hold_start_at_degenerate_scan(stamp_ns, measured, frame, rest_jitter);
   if (frame.drop_reason.empty() && fusion_ && has_imu() && beyond_bridged_gap(stamp_ns)) {
     frame.drop_reason =
         "not fused: the scan ends " + seconds_text(after_newest_imu_s(stamp_ns)) +
@@ -538,7 +597,7 @@ void FusionDriver::link(const Scan& scan, OdometryFrame& frame) {
             fusion::velocity_measurement_covariance(*covariance, *last_covariance_, dt_s, fusion_->config());
       }
     }
-    fuse_when_covered({stamp_ns, measured, velocity, has_velocity, covariance, velocity_covariance});
+    fuse_when_covered({stamp_ns, measured, velocity, has_velocity, covariance, velocity_covariance, rest_jitter});
     frame.fused = true;
   }
   last_body_ = StampedPose{scan.end_stamp_ns, measured};

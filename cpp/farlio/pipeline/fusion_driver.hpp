@@ -34,7 +34,11 @@
 //     with that drop reason and one warning;
 //   a result with a degenerate translation does not initialise the filter (its pose says nothing
 //     of the velocity along that direction): it restarts the initialisation window, with that drop
-//     reason, and after kDegenerateStartWarning_s of them without a filter, one warning.
+//     reason, and after kDegenerateStartWarning_s of them without a filter, one warning; unless it
+//     stands within its own stds while an IMU no noisier than the configured input noise reads
+//     gravity alone, after a scan that constrains every direction stood so and with every scan
+//     since standing (a narrow field of view on the grid): then it enters the window with its stds
+//     as its rest jitter, and the filter starts at rest.
 #include <cstdint>
 #include <deque>
 #include <optional>
@@ -93,6 +97,7 @@ struct PendingResult {
   bool has_velocity = false;
   std::optional<Mat6d> covariance;
   std::optional<Eigen::Matrix3d> velocity_covariance;
+  fusion::RestJitter rest_jitter;  ///< a degenerate scan at rest: its own stds (SensorFusion::add_lidar)
 };
 
 /// Why a scan's result must not reach the fusion; empty when it may.
@@ -186,7 +191,16 @@ class FusionDriver {
   void warn_undecided_gyro(std::int64_t stamp_ns);
   /// Before the filter: a scan with a degenerate translation restarts the initialisation window and
   /// is not fused (with a warning once such scans have held the start for a while).
-  void hold_start_at_degenerate_scan(std::int64_t stamp_ns, OdometryFrame& frame);
+  /// A degenerate scan that stands as the IMU does, after a scan that constrains every direction
+  /// stood and with every scan since standing, passes, with its stds as its rest jitter.
+  void hold_start_at_degenerate_scan(std::int64_t stamp_ns, const SE3& measured, OdometryFrame& frame,
+                                     fusion::RestJitter& rest_jitter);
+  /// Whether a scan and the IMU since the last scan show rest: the scan moved within its own stds
+  /// and the IMU read gravity alone, unturned (within its measured noise, once measured).
+  [[nodiscard]] bool scan_stands(std::int64_t stamp_ns, const SE3& measured,
+                                 const registration::Degeneracy& degeneracy) const;
+  /// Whether the IMU's noise is measured and within fusion.gyro_input_std_rad_s / accel_input_std_m_s2.
+  [[nodiscard]] bool imu_within_configured_noise() const;
   /// Fuses `result` now, or once the IMU reaches its stamp (a LiDAR result ahead of the newest
   /// IMU sample waits: the filter predicts only with inputs it has).
   void fuse_when_covered(PendingResult result);
@@ -224,6 +238,7 @@ class FusionDriver {
   Eigen::Vector3d gyro_weight_sum_ = Eigen::Vector3d::Zero();  ///< over the blended scans, for stats()
   std::int64_t blended_scans_ = 0;
   bool warned_degenerate_start_ = false;
+  bool rest_seen_by_constrained_scan_ = false;  ///< since then, every scan stood (scan_stands)
   std::int64_t clock_ns_ = 0;
   std::int64_t next_output_ns_ = 0;  ///< 0: set by the first IMU sample
   std::optional<std::int64_t> last_output_ns_;
