@@ -108,7 +108,7 @@ def test_a_mid360_on_the_racetrack_starts_the_filter_standing_and_beats_lidar_on
 def test_a_forward_livox_with_a_race_cars_imu_does_not_start_the_filter_standing():
     """The same Avia with a vibrating race car's IMU (noisier than the filter's configured input
     noise): a filter started from degenerate scans carries the unconstrained direction on that
-    accelerometer, and ran 0.18-0.40 m off against LiDAR-only's 0.065-0.075 m. The standing start
+    accelerometer, and ran 0.18-0.40 m off against LiDAR-only's 0.063-0.075 m. The standing start
     from degenerate scans is therefore refused; the IMU serves the scans' guess and undistortion
     and the scan poses stay no worse than LiDAR-only's."""
     import math
