@@ -30,8 +30,8 @@ constexpr double kTurnConfirmationRatio = 2.0;
 constexpr double kUndecidedGyroWarning_s = 10.0;
 /// Degenerate scans that have kept the filter from starting for this long get a warning.
 constexpr double kDegenerateStartWarning_s = 2.0;
-/// A degenerate scan stands when the IMU's mean over its interval is within the rest bounds widened
-/// by this many stds of that mean's noise.
+/// A scan stands (FusionDriver::scan_stands) when the IMU's mean over its interval is within the rest
+/// bounds widened by this many stds of that mean's noise.
 constexpr double kRestNoiseSigmas = 3.0;
 /// Warnings kept between two take_warnings calls; later ones are left out (a last one says so).
 constexpr std::size_t kMaxPendingWarnings = 100;
