@@ -16,6 +16,9 @@ constexpr std::size_t kExtraHistoryEntries = 2;  ///< both ends of the history s
 /// In motion, the LiDAR results the alignment needs at least (two equations a pair, six unknowns
 /// a pose: three poses make it overdetermined).
 constexpr std::size_t kMinPosesInMotion = 3;
+/// The LiDAR poses of a body at rest move by up to this between two scans (registration noise):
+/// a window whose results move less shows rest whatever the scan rate.
+constexpr double kRestPositionJitter_m = 0.02;
 /// The zero-velocity prior of a window that shows the body at rest (m/s): tight, so that gravity
 /// follows from the specific force as in levelling.
 constexpr double kRestVelocityStd_m_s = 0.01;
@@ -297,14 +300,19 @@ std::optional<Eigen::Matrix3d> SensorFusion::imu_rotation(std::int64_t start_ns,
   return increment->rotation;
 }
 
+bool moved_within_rest(const SE3& motion, double dt_s, const FusionConfig& config, const RestJitter& jitter) {
+  const double jitter_m = std::max(kRestPositionJitter_m, jitter.translation_m);
+  return motion.translation().norm() <= std::max(config.standstill.max_speed_m_s * dt_s, jitter_m) &&
+         motion.angle_rad() <= std::max(config.standstill.max_gyro_rad_s * dt_s, jitter.rotation_rad);
+}
+
 bool SensorFusion::window_at_rest() const {
   for (std::size_t k = 1; k < window_.size(); ++k) {
-    const double dt_s = ns_to_seconds(window_[k].stamp_ns - window_[k - 1].stamp_ns);
-    const SE3 motion = window_[k - 1].body_pose.inverse() * window_[k].body_pose;
-    const double jitter_m = std::max({kRestPositionJitter_m, window_[k - 1].rest_jitter_m, window_[k].rest_jitter_m});
-    const double jitter_rad = std::max(window_[k - 1].rest_jitter_rad, window_[k].rest_jitter_rad);
-    if (motion.translation().norm() > std::max(config_.standstill.max_speed_m_s * dt_s, jitter_m) ||
-        motion.angle_rad() > std::max(config_.standstill.max_gyro_rad_s * dt_s, jitter_rad))
+    const WindowPose& a = window_[k - 1];
+    const WindowPose& b = window_[k];
+    const RestJitter jitter{std::max(a.rest_jitter_m, b.rest_jitter_m), std::max(a.rest_jitter_rad, b.rest_jitter_rad)};
+    if (!moved_within_rest(a.body_pose.inverse() * b.body_pose, ns_to_seconds(b.stamp_ns - a.stamp_ns), config_,
+                           jitter))
       return false;
   }
   return window_.size() >= 2;

@@ -76,6 +76,13 @@ std::optional<RotationLine> gyro_rotation_line(const fusion::SensorFusion& fusio
   return RotationLine{line.offset.tail<3>().cast<double>(), line.rate.tail<3>().cast<double>()};
 }
 
+/// A mean specific force within max_accel_deviation of gravity and a mean rate within max_gyro: at
+/// rest or at a constant velocity.
+bool reads_gravity_alone(const Eigen::Vector3d& accel_m_s2, const Eigen::Vector3d& gyro_rad_s, double gravity_m_s2,
+                         double max_accel_deviation_m_s2, double max_gyro_rad_s) {
+  return std::abs(accel_m_s2.norm() - gravity_m_s2) <= max_accel_deviation_m_s2 && gyro_rad_s.norm() <= max_gyro_rad_s;
+}
+
 bool in_gravity_window(const ImuSample& first, const ImuSample& s) {
   return s.stamp_ns - first.stamp_ns <= seconds_to_ns(kGravityAlignmentWindow_s);
 }
@@ -107,7 +114,7 @@ SE3 gravity_aligned_start(const std::vector<ImuSample>& imu, std::int64_t until_
   if (mean.norm() <= 0.0 || !mean.allFinite()) return SE3();
   // accelerating or turning, the specific force is not gravity: the body's own attitude is as good
   // a guess (a car's roll and pitch are small), and the filter finds gravity in motion
-  if (std::abs(mean.norm() - gravity_m_s2) > kLevelledStartMaxAccelDeviation_m_s2 || mean_gyro.norm() > max_gyro_rad_s)
+  if (!reads_gravity_alone(mean, mean_gyro, gravity_m_s2, kLevelledStartMaxAccelDeviation_m_s2, max_gyro_rad_s))
     return SE3();
   const double roll = std::atan2(mean.y(), mean.z());
   const double pitch = std::atan2(-mean.x(), std::hypot(mean.y(), mean.z()));
@@ -496,12 +503,8 @@ bool FusionDriver::scan_stands(std::int64_t stamp_ns, const SE3& measured,
   // degenerate scan) at a constant velocity along the direction it does not constrain
   if (!last_body_ || stamp_ns <= last_body_->stamp_ns) return false;
   const double dt_s = ns_to_seconds(stamp_ns - last_body_->stamp_ns);
-  const SE3 motion = last_body_->pose.inverse() * measured;
-  const double jitter_m = std::max(fusion::kRestPositionJitter_m, degeneracy.translation_std_m.maxCoeff());
-  const double jitter_rad = degeneracy.rotation_std_rad.maxCoeff();
-  if (motion.translation().norm() > std::max(fusion_config_.standstill.max_speed_m_s * dt_s, jitter_m) ||
-      motion.angle_rad() > std::max(fusion_config_.standstill.max_gyro_rad_s * dt_s, jitter_rad))
-    return false;
+  const fusion::RestJitter own_stds{degeneracy.translation_std_m.maxCoeff(), degeneracy.rotation_std_rad.maxCoeff()};
+  if (!fusion::moved_within_rest(last_body_->pose.inverse() * measured, dt_s, fusion_config_, own_stds)) return false;
   const auto mean = fusion_->imu_mean(last_body_->stamp_ns, stamp_ns);
   if (!mean) return false;
   double accel_std = 0.0, gyro_std = 0.0;  // of the mean over the interval, once measured
@@ -509,9 +512,9 @@ bool FusionDriver::scan_stands(std::int64_t stamp_ns, const SE3& measured,
     accel_std = noise->accel_step_std_m_s2(dt_s).norm();
     gyro_std = noise->gyro_step_std_rad_s(dt_s).norm();
   }
-  return std::abs(mean->accel_m_s2.norm() - gravity_m_s2_) <=
-             kLevelledStartMaxAccelDeviation_m_s2 + kRestNoiseSigmas * accel_std &&
-         mean->gyro_rad_s.norm() <= fusion_config_.standstill.max_gyro_rad_s + kRestNoiseSigmas * gyro_std;
+  return reads_gravity_alone(mean->accel_m_s2, mean->gyro_rad_s, gravity_m_s2_,
+                             kLevelledStartMaxAccelDeviation_m_s2 + kRestNoiseSigmas * accel_std,
+                             fusion_config_.standstill.max_gyro_rad_s + kRestNoiseSigmas * gyro_std);
 }
 
 bool FusionDriver::imu_within_configured_noise() const {
@@ -540,7 +543,7 @@ void FusionDriver::hold_start_at_degenerate_scan(std::int64_t stamp_ns, const SE
   // measured within the filter's configured input noise (not a vibrating race car's) may start it
   if (rest_seen_by_constrained_scan_ && imu_within_configured_noise()) {
     rest_jitter = {frame.degeneracy->translation_std_m.maxCoeff(), frame.degeneracy->rotation_std_rad.maxCoeff()};
-    return;
+    return;  // the same stds scan_stands allowed
   }
   // a pose that stands still along a direction the scan does not constrain says nothing of the
   // velocity there (a sparse LiDAR at speed between parallel walls registers as standing): the
