@@ -25,14 +25,19 @@
 
 namespace farlio::fusion {
 
+/// A pose's jitter at rest beyond the LiDAR's usual 2 cm (SensorFusion::add_lidar): a degenerate
+/// scan's own stds along its worst translation and rotation, which the caller passes only where
+/// the IMU reads rest too (a narrow field of view standing: FusionDriver); 0 otherwise.
+struct RestJitter {
+  double translation_m = 0.0;
+  double rotation_rad = 0.0;
+};
+
 /// A LiDAR result the window holds: the body pose in the map frame at its scan end.
 struct WindowPose {
   std::int64_t stamp_ns = 0;
   SE3 body_pose;
-  /// How far the LiDAR's pose jitters at rest beyond the usual (m, rad): a degenerate scan's own
-  /// stds, which the driver passes only where the IMU too reads rest (FusionDriver); 0 otherwise.
-  double rest_jitter_m = 0.0;
-  double rest_jitter_rad = 0.0;
+  RestJitter rest_jitter;  ///< how far it may jitter at rest beyond the usual
 };
 
 /// The IMU over [start_ns, end_ns] as the alignment reads it: the mean specific force (m/s^2) and

@@ -278,7 +278,7 @@ void SensorFusion::add_to_window(std::int64_t stamp_ns, const SE3& body_pose, co
   if (!window_.empty() && stamp_ns <= window_.back().stamp_ns) return;
   const auto span_s = [&](const WindowPose& from) { return ns_to_seconds(stamp_ns - from.stamp_ns); };
   if (!window_.empty() && span_s(window_.back()) > config_.init.window_s) window_.clear();  // an outage
-  window_.push_back({stamp_ns, body_pose, rest_jitter.translation_m, rest_jitter.rotation_rad});
+  window_.push_back({stamp_ns, body_pose, rest_jitter});
   // the shortest run of the newest results that spans fusion.init.window_s
   while (window_.size() > 2 && span_s(window_[1]) >= config_.init.window_s) window_.erase(window_.begin());
 }
@@ -310,7 +310,8 @@ bool SensorFusion::window_at_rest() const {
   for (std::size_t k = 1; k < window_.size(); ++k) {
     const WindowPose& a = window_[k - 1];
     const WindowPose& b = window_[k];
-    const RestJitter jitter{std::max(a.rest_jitter_m, b.rest_jitter_m), std::max(a.rest_jitter_rad, b.rest_jitter_rad)};
+    const RestJitter jitter{std::max(a.rest_jitter.translation_m, b.rest_jitter.translation_m),
+                            std::max(a.rest_jitter.rotation_rad, b.rest_jitter.rotation_rad)};
     if (!moved_within_rest(a.body_pose.inverse() * b.body_pose, ns_to_seconds(b.stamp_ns - a.stamp_ns), config_,
                            jitter))
       return false;

@@ -85,14 +85,6 @@ struct LidarUpdateResult {
   std::string rejection_reason;     ///< set when the whole result was rejected
 };
 
-/// A pose's jitter at rest beyond the LiDAR's usual 2 cm (add_lidar): a degenerate scan's own
-/// stds along its worst translation and rotation, which the caller passes only where the IMU reads
-/// rest too (a narrow field of view standing: FusionDriver).
-struct RestJitter {
-  double translation_m = 0.0;
-  double rotation_rad = 0.0;
-};
-
 /// Whether a body that moved by `motion` over dt_s stood: a displacement within
 /// fusion.standstill.max_speed_m_s or the LiDAR's jitter (2 cm, or the larger rest jitter), and a
 /// rotation within fusion.standstill.max_gyro_rad_s or the rest jitter's.

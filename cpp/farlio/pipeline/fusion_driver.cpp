@@ -497,13 +497,11 @@ void FusionDriver::warn_undecided_gyro(std::int64_t stamp_ns) {
   }
 }
 
-bool FusionDriver::scan_stands(std::int64_t stamp_ns, const SE3& measured,
-                               const registration::Degeneracy& degeneracy) const {
+bool FusionDriver::scan_stands(std::int64_t stamp_ns, const SE3& measured, const fusion::RestJitter& own_stds) const {
   // the scan moved within its own stds and the IMU read gravity alone, unturned: at rest, or (a
   // degenerate scan) at a constant velocity along the direction it does not constrain
   if (!last_body_ || stamp_ns <= last_body_->stamp_ns) return false;
   const double dt_s = ns_to_seconds(stamp_ns - last_body_->stamp_ns);
-  const fusion::RestJitter own_stds{degeneracy.translation_std_m.maxCoeff(), degeneracy.rotation_std_rad.maxCoeff()};
   if (!fusion::moved_within_rest(last_body_->pose.inverse() * measured, dt_s, fusion_config_, own_stds)) return false;
   const auto mean = fusion_->imu_mean(last_body_->stamp_ns, stamp_ns);
   if (!mean) return false;
@@ -533,7 +531,9 @@ void FusionDriver::hold_start_at_degenerate_scan(std::int64_t stamp_ns, const SE
   // a degenerate scan standing enters the window once a scan that constrains every direction has
   // shown the body at rest, and no scan since has moved or felt more than rest (coasting along
   // parallel walls, every scan degenerate, reads as rest to every sensor on board: held)
-  const bool stands = scan_stands(stamp_ns, measured, *frame.degeneracy);
+  const fusion::RestJitter own_stds{frame.degeneracy->translation_std_m.maxCoeff(),
+                                    frame.degeneracy->rotation_std_rad.maxCoeff()};
+  const bool stands = scan_stands(stamp_ns, measured, own_stds);
   if (frame.degeneracy->degenerate_translations == 0) {
     rest_seen_by_constrained_scan_ = stands;
     return;
@@ -542,8 +542,8 @@ void FusionDriver::hold_start_at_degenerate_scan(std::int64_t stamp_ns, const SE
   // a filter started there carries the unconstrained direction on the accelerometer: only an IMU
   // measured within the filter's configured input noise (not a vibrating race car's) may start it
   if (rest_seen_by_constrained_scan_ && imu_within_configured_noise()) {
-    rest_jitter = {frame.degeneracy->translation_std_m.maxCoeff(), frame.degeneracy->rotation_std_rad.maxCoeff()};
-    return;  // the same stds scan_stands allowed
+    rest_jitter = own_stds;  // the jitter scan_stands allowed
+    return;
   }
   // a pose that stands still along a direction the scan does not constrain says nothing of the
   // velocity there (a sparse LiDAR at speed between parallel walls registers as standing): the

@@ -197,8 +197,7 @@ class FusionDriver {
                                      fusion::RestJitter& rest_jitter);
   /// Whether a scan and the IMU since the last scan show rest: the scan moved within its own stds
   /// and the IMU read gravity alone, unturned (within its measured noise, once measured).
-  [[nodiscard]] bool scan_stands(std::int64_t stamp_ns, const SE3& measured,
-                                 const registration::Degeneracy& degeneracy) const;
+  [[nodiscard]] bool scan_stands(std::int64_t stamp_ns, const SE3& measured, const fusion::RestJitter& own_stds) const;
   /// Whether the IMU's noise is measured and within fusion.gyro_input_std_rad_s / accel_input_std_m_s2.
   [[nodiscard]] bool imu_within_configured_noise() const;
   /// Fuses `result` now, or once the IMU reaches its stamp (a LiDAR result ahead of the newest
