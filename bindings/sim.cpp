@@ -23,8 +23,9 @@ void bind_profiles(nb::module_& m) {
       .value("Racetrack", Profile::Racetrack)
       .value("Urban", Profile::Urban)
       .value("Handheld", Profile::Handheld)
-      .value("Tunnel", Profile::Tunnel);
-  m.def("parse_profile", &parse_profile, "name"_a, "'racetrack' | 'urban' | 'handheld' | 'tunnel'.");
+      .value("Tunnel", Profile::Tunnel)
+      .value("Garage", Profile::Garage);
+  m.def("parse_profile", &parse_profile, "name"_a, "'racetrack' | 'urban' | 'handheld' | 'tunnel' | 'garage'.");
   m.def("profile_name", &profile_name, "profile"_a);
   nb::enum_<LidarModel>(m, "LidarModel")
       .value("Profile", LidarModel::Profile)

@@ -14,7 +14,7 @@ import farlio
 from farlio import _core
 
 #: the generator's profiles (docs/simulation.md)
-PROFILES = ("racetrack", "urban", "handheld", "tunnel")
+PROFILES = ("racetrack", "urban", "handheld", "tunnel", "garage")
 #: rate of groundtruth.tum (body poses); the scan-end poses are in groundtruth_scans.tum
 GROUNDTRUTH_RATE_HZ = 100.0
 

@@ -62,7 +62,7 @@ Window make_window(const std::string& profile, double motion_start_s, double spa
     SE3 pose = w.map_from_world * gen.state(t).pose_world_body;
     if (pose_noise_m > 0.0)
       pose = SE3(pose.rotation(), pose.translation() + Eigen::Vector3d(noise(rng), noise(rng), noise(rng)));
-    w.poses.push_back({t, pose});
+    w.poses.push_back({t, pose, {}});
   }
   const Eigen::Matrix3d R = w.map_from_world.rotation();
   w.true_gravity_map = R * Eigen::Vector3d(0, 0, -cfg.gravity_m_s2);

@@ -1,6 +1,7 @@
 // Building blocks of the simulator against exact references.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <numbers>
 
@@ -86,6 +87,42 @@ TEST(SimPrimitives, BoxCylinderGroundAgainstAnalyticHits) {
   EXPECT_NEAR(p.x(), -45.0, 1e-9);
 }
 
+TEST(SimPrimitives, AnInclinedBoxIsHitOnItsSlopedTopAndSides) {
+  // A ramp 10 m long (x in [0, 10]) rising 1 m (slope 0.1), 0.3 m thick, turned by 30 degrees.
+  const double yaw = std::numbers::pi / 6, slope = 0.1;
+  Box ramp{Eigen::Vector3d(5, 0, 0.5 - 0.15), Eigen::Vector3d(5, 2, 0.15), 0.0, 0.5F};
+  ramp.slope = slope;
+  const Eigen::Vector3d down(0, 0, -1);
+  for (const double x : {0.5, 3.0, 7.5, 9.9}) {  // straight down onto the top: z = slope * x
+    const auto h = ramp.intersect(Eigen::Vector3d(x, 1.0, 5.0), down, 100.0);
+    ASSERT_TRUE(h) << x;
+    EXPECT_NEAR(5.0 - h->range_m, slope * x, 1e-12) << x;
+    EXPECT_NEAR(h->normal.dot(Eigen::Vector3d(-slope, 0, 1).normalized()), 1.0, 1e-12);
+  }
+  EXPECT_FALSE(ramp.intersect(Eigen::Vector3d(10.5, 0, 5), down, 100.0));      // beyond its end
+  const auto under = ramp.intersect(Eigen::Vector3d(8, 0, -3), -down, 100.0);  // the bottom face
+  ASSERT_TRUE(under);
+  EXPECT_NEAR(-3.0 + under->range_m, slope * 8 - 0.3, 1e-12);
+  const auto side = ramp.intersect(Eigen::Vector3d(20, 0, 0.75), -Eigen::Vector3d::UnitX(), 100.0);
+  ASSERT_TRUE(side);  // the vertical end at x = 10 spans z in [0.7, 1.0]
+  EXPECT_NEAR(side->range_m, 10.0, 1e-12);
+  EXPECT_NEAR(ramp.surface_distance_m(Eigen::Vector3d(4, 0, slope * 4 + 0.2)), 0.2 / std::sqrt(1 + slope * slope),
+              1e-12);
+
+  // Turned: the same hits in the rotated frame; a level box (slope 0) is the box of before.
+  Box turned = ramp;
+  turned.yaw_rad = yaw;
+  turned.center_m = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * ramp.center_m;
+  const Eigen::Vector3d p = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * Eigen::Vector3d(7.5, 1.0, 5.0);
+  const auto h = turned.intersect(p, down, 100.0);
+  ASSERT_TRUE(h);
+  EXPECT_NEAR(5.0 - h->range_m, slope * 7.5, 1e-12);
+  const Box level{Eigen::Vector3d(5, 0, 0), Eigen::Vector3d(5, 2, 0.15), yaw, 0.5F};
+  const auto flat = level.intersect(Eigen::Vector3d(5, 0, 5), down, 100.0);
+  ASSERT_TRUE(flat);
+  EXPECT_NEAR(flat->range_m, 4.85, 1e-12);
+}
+
 TEST(SimScene, GridCastEqualsBruteForce) {
   Scene scene;
   std::uint64_t state = 12345;
@@ -95,7 +132,8 @@ TEST(SimScene, GridCastEqualsBruteForce) {
   };
   for (int i = 0; i < 300; ++i)
     scene.add(Box{Eigen::Vector3d(rnd(-100, 100), rnd(-100, 100), rnd(0, 5)),
-                  Eigen::Vector3d(rnd(0.2, 6), rnd(0.2, 6), rnd(0.5, 4)), rnd(-3, 3), 0.5F});
+                  Eigen::Vector3d(rnd(0.2, 6), rnd(0.2, 6), rnd(0.5, 4)), rnd(-3, 3), 0.5F,
+                  i % 3 == 0 ? rnd(-0.3, 0.3) : 0.0});  // every third one a ramp
   for (int i = 0; i < 200; ++i)
     scene.add(Cylinder{Eigen::Vector2d(rnd(-100, 100), rnd(-100, 100)), rnd(0.1, 2), 0.0, rnd(1, 10), 0.5F});
   scene.build_index(7.0);

@@ -151,8 +151,50 @@ TEST(SimProfiles, TunnelDrivesStraightThroughTheTunnel) {
   EXPECT_GT(state_at(cfg.duration_s).pose_world_body.translation().x(), fact("tunnel_end_x_m"));
 }
 
+TEST(SimProfiles, GarageDrivesUpItsRampsThroughIdenticalLevels) {
+  const SimConfig cfg = default_config(Profile::Garage);
+  const SequenceGenerator gen(cfg);
+  const auto fact = [&](const char* key) { return std::stod(gen.description().at(key)); };
+  const double level_m = fact("level_height_m");
+  const Extremes e = sample(gen, cfg.duration_s);
+  EXPECT_NEAR(e.standstill_s, 2.0, 0.05);
+  EXPECT_LE(e.max_speed_m_s, 6.5);  // 6 m/s along the floor, a little more up a ramp
+  EXPECT_NEAR(e.z_max_m - e.z_min_m, (fact("levels") - 1.0) * level_m, 1e-6);
+  // The car drives on the scene's floors and ramps: the surface under the body is the body's
+  // height below it (the ramps' inclined pieces follow the road to within a centimetre), and it
+  // stays inside the garage's walls.
+  const double body_height_m = e.z_min_m;
+  for (double t = 0.0; t <= cfg.duration_s; t += 0.1) {
+    const Eigen::Vector3d p = gen.state(cfg.start_stamp_ns + std::llround(t * 1e9)).pose_world_body.translation();
+    const auto below = gen.scene().cast(p, -Eigen::Vector3d::UnitZ(), 10.0);
+    ASSERT_TRUE(below) << t;
+    EXPECT_NEAR(below->range_m, body_height_m, 0.01) << t;
+    EXPECT_GT(p.x(), 0.0);
+    EXPECT_LT(p.x(), 72.0);
+    EXPECT_GT(p.y(), 0.0);
+    EXPECT_LT(p.y(), 41.0);
+  }
+  // Levels 1 and 2 look the same from the inside: a ray from the same place at the LiDAR's height
+  // above either floor returns the same range, unless it climbs through the ramp lane's openings
+  // of two slabs (into level 3 from level 1, against the roof from level 2): 4 of 3528 rays.
+  int rays = 0, same = 0;
+  for (double x = 12.0; x <= 60.0; x += 8.0)
+    for (int a = 0; a < 48; ++a)
+      for (double elevation_deg = -24.0; elevation_deg <= 2.0; elevation_deg += 2.0) {
+        const double az = 2.0 * M_PI * a / 48.0, el = elevation_deg * M_PI / 180.0;
+        const Eigen::Vector3d dir(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
+        const auto one = gen.scene().cast(Eigen::Vector3d(x, 8.0, level_m + 1.8), dir, 120.0);
+        const auto two = gen.scene().cast(Eigen::Vector3d(x, 8.0, 2.0 * level_m + 1.8), dir, 120.0);
+        ASSERT_TRUE(one && two);
+        same += std::abs(one->range_m - two->range_m) < 1e-9 ? 1 : 0;
+        ++rays;
+      }
+  EXPECT_GT(rays, 3000);
+  EXPECT_GE(same, rays - 10);
+}
+
 TEST(SimProfiles, GroundTruthTrajectories) {
-  for (const Profile p : {Profile::Racetrack, Profile::Urban, Profile::Handheld, Profile::Tunnel}) {
+  for (const Profile p : {Profile::Racetrack, Profile::Urban, Profile::Handheld, Profile::Tunnel, Profile::Garage}) {
     SimConfig cfg = default_config(p);
     cfg.duration_s = 3.0;
     const SequenceGenerator gen(cfg);
@@ -172,7 +214,7 @@ TEST(SimProfiles, GroundTruthTrajectories) {
 
 TEST(SimProfiles, VelocityIsTheDerivativeOfPosition) {
   // Central differences of the exact poses agree with the analytic velocity and rate.
-  for (const Profile p : {Profile::Racetrack, Profile::Urban, Profile::Handheld, Profile::Tunnel}) {
+  for (const Profile p : {Profile::Racetrack, Profile::Urban, Profile::Handheld, Profile::Tunnel, Profile::Garage}) {
     const SequenceGenerator gen(default_config(p));
     constexpr std::int64_t kStep_ns = 1'000'000;
     for (const double t : {0.3, 3.7, 11.1, 25.9, 47.3}) {
@@ -226,15 +268,16 @@ TEST(SimConfigApi, ParseProfile) {
   EXPECT_EQ(parse_profile("urban"), Profile::Urban);
   EXPECT_EQ(parse_profile("handheld"), Profile::Handheld);
   EXPECT_EQ(parse_profile("tunnel"), Profile::Tunnel);
+  EXPECT_EQ(parse_profile("garage"), Profile::Garage);
   try {
     (void)parse_profile("moon");
     FAIL() << "expected an error";
   } catch (const std::invalid_argument& e) {
     const std::string msg = e.what();
-    for (const char* name : {"moon", "racetrack", "urban", "handheld", "tunnel"})
+    for (const char* name : {"moon", "racetrack", "urban", "handheld", "tunnel", "garage"})
       EXPECT_NE(msg.find(name), std::string::npos);
   }
-  for (const Profile p : {Profile::Racetrack, Profile::Urban, Profile::Handheld, Profile::Tunnel})
+  for (const Profile p : {Profile::Racetrack, Profile::Urban, Profile::Handheld, Profile::Tunnel, Profile::Garage})
     EXPECT_EQ(parse_profile(profile_name(p)), p);
 }
 

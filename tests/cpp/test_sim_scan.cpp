@@ -19,6 +19,7 @@ std::size_t moving_scan(Profile p) {
     case Profile::Urban: return 100;
     case Profile::Handheld: return 40;
     case Profile::Tunnel: return 100;  // 10 s: ~16 m/s, approaching the tunnel portal
+    case Profile::Garage: return 100;  // 10 s: on the bottom aisle
   }
   return 0;
 }
@@ -128,7 +129,8 @@ TEST_P(SimScanProfile, SameSeedBitIdenticalInAnyOrderOtherSeedDiffers) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Profiles, SimScanProfile,
-                         ::testing::Values(Profile::Racetrack, Profile::Urban, Profile::Handheld, Profile::Tunnel),
+                         ::testing::Values(Profile::Racetrack, Profile::Urban, Profile::Handheld, Profile::Tunnel,
+                                           Profile::Garage),
                          [](const ::testing::TestParamInfo<Profile>& param_info) {
                            return profile_name(param_info.param);
                          });

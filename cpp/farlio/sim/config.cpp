@@ -12,7 +12,7 @@ struct ProfileDefaults {
   NoiseConfig noise;
 };
 
-/// The urban car's LiDAR and IMU noise (urban and tunnel).
+/// The urban car's LiDAR and IMU noise (urban, tunnel and garage).
 NoiseConfig car_noise() {
   return NoiseConfig{
       0.02, 0.01, 0.003, 0.05, 2e-5, 3e-4, Eigen::Vector3d(0.001, -0.0015, 0.0008), Eigen::Vector3d(0.04, 0.03, -0.05)};
@@ -25,7 +25,8 @@ ProfileDefaults defaults_of(Profile p) {
               NoiseConfig{0.02, 0.02, 0.02, 0.5, 2e-4, 2e-3, Eigen::Vector3d(0.003, -0.002, 0.001),
                           Eigen::Vector3d(0.08, -0.05, 0.06)}};
     case Profile::Urban: return {120.0, 10.0, 100.0, car_noise()};
-    case Profile::Tunnel: return {45.0, 10.0, 100.0, car_noise()};  // the urban car's sensors
+    case Profile::Tunnel: return {45.0, 10.0, 100.0, car_noise()};   // the urban car's sensors
+    case Profile::Garage: return {180.0, 10.0, 100.0, car_noise()};  // the same; the route ends at 183.5 s
     case Profile::Handheld:
       return {90.0, 10.0, 200.0,
               NoiseConfig{0.01, 0.01, 0.005, 0.08, 4e-5, 6e-4, Eigen::Vector3d(-0.002, 0.001, 0.0015),
@@ -51,7 +52,9 @@ Profile parse_profile(const std::string& name) {
   if (name == "urban") return Profile::Urban;
   if (name == "handheld") return Profile::Handheld;
   if (name == "tunnel") return Profile::Tunnel;
-  throw std::invalid_argument("unknown simulation profile '" + name + "' (valid: racetrack, urban, handheld, tunnel)");
+  if (name == "garage") return Profile::Garage;
+  throw std::invalid_argument("unknown simulation profile '" + name +
+                              "' (valid: racetrack, urban, handheld, tunnel, garage)");
 }
 
 std::string profile_name(Profile profile) {
@@ -60,6 +63,7 @@ std::string profile_name(Profile profile) {
     case Profile::Urban: return "urban";
     case Profile::Handheld: return "handheld";
     case Profile::Tunnel: return "tunnel";
+    case Profile::Garage: return "garage";
   }
   throw std::invalid_argument("unknown profile");
 }

@@ -10,9 +10,9 @@
 
 namespace farlio::sim {
 
-enum class Profile { Racetrack, Urban, Handheld, Tunnel };
+enum class Profile { Racetrack, Urban, Handheld, Tunnel, Garage };
 
-/// "racetrack" | "urban" | "handheld" | "tunnel"; throws std::invalid_argument listing the valid names.
+/// "racetrack" | "urban" | "handheld" | "tunnel" | "garage"; throws std::invalid_argument listing the valid names.
 Profile parse_profile(const std::string& name);
 std::string profile_name(Profile profile);
 

@@ -67,6 +67,7 @@ VibrationConfig platform_vibration(Profile profile) {
   switch (profile) {
     case Profile::Urban:   // a passenger car on city streets, <= 14 m/s
     case Profile::Tunnel:  // the same car on a motorway, <= 28 m/s
+    case Profile::Garage:  // and in a parking garage, <= 6 m/s
       v.wheel_radius_m = 0.32;
       v.accel_wheel_amplitude_m_s2_per_m_s = {0.005, 0.005, 0.015};
       v.gyro_wheel_amplitude_rad_s_per_m_s = {2e-4, 2e-4, 1e-4};

@@ -19,21 +19,31 @@ Eigen::Vector3d euler_zyx_body_rate(const EulerZyx& e) {
           -e.pitch_rate_rad_s * sr + e.yaw_rate_rad_s * cp * cr};
 }
 
-VehicleMotion::VehicleMotion(Path path, SpeedPlan plan, SmoothCurve ground_height_of_x_m, double body_height_m)
+VehicleMotion::VehicleMotion(Path path, SpeedPlan plan, SmoothCurve road_height_m, double body_height_m,
+                             RoadHeightOf height_of)
     : path_(std::move(path)),
       plan_(std::move(plan)),
-      ground_(std::move(ground_height_of_x_m)),
-      body_height_m_(body_height_m) {}
+      road_(std::move(road_height_m)),
+      body_height_m_(body_height_m),
+      height_of_(height_of) {}
 
 BodyState VehicleMotion::state(double t_s) const {
   const Progress pr = plan_.at(t_s);
   const PathPoint pp = path_.at(pr.s_m);
-  // Road height z(s) = ground(x(s)) and its derivatives along the (horizontal) arc length.
+  // Road height z(s) and its derivatives along the (horizontal) arc length: z = road(s), or
+  // z = road(x(s)) by the chain rule.
   const double x = pp.position_m.x();
-  const double dx_ds = pp.tangent.x(), d2x_ds2 = pp.curvature_1_m * pp.normal.x();
-  const double z = ground_.value(x);
-  const double dz_ds = ground_.derivative(x) * dx_ds;
-  const double d2z_ds2 = ground_.second_derivative(x) * dx_ds * dx_ds + ground_.derivative(x) * d2x_ds2;
+  double z = 0.0, dz_ds = 0.0, d2z_ds2 = 0.0;
+  if (height_of_ == RoadHeightOf::ArcLength) {
+    z = road_.value(pr.s_m);
+    dz_ds = road_.derivative(pr.s_m);
+    d2z_ds2 = road_.second_derivative(pr.s_m);
+  } else {
+    const double dx_ds = pp.tangent.x(), d2x_ds2 = pp.curvature_1_m * pp.normal.x();
+    z = road_.value(x);
+    dz_ds = road_.derivative(x) * dx_ds;
+    d2z_ds2 = road_.second_derivative(x) * dx_ds * dx_ds + road_.derivative(x) * d2x_ds2;
+  }
 
   const Eigen::Vector3d d1(pp.tangent.x(), pp.tangent.y(), dz_ds);  // dp/ds
   const Eigen::Vector3d d2(pp.curvature_1_m * pp.normal.x(), pp.curvature_1_m * pp.normal.y(), d2z_ds2);

@@ -35,11 +35,17 @@ class MotionModel {
   [[nodiscard]] virtual BodyState state(double t_s) const = 0;
 };
 
+/// What a VehicleMotion's road height is a function of: the world x (a landscape's ground,
+/// GroundProfile) or the arc length along the path (a road that crosses itself at different
+/// heights: a parking garage's ramps).
+enum class RoadHeightOf { WorldX, ArcLength };
+
 /// A ground vehicle following a path: body x along the path tangent, pitched with the road
-/// grade, no roll; the body sits body_height_m above the ground surface z = ground(x).
+/// grade, no roll; the body sits body_height_m above the road surface z = road(x) or road(s).
 class VehicleMotion final : public MotionModel {
  public:
-  VehicleMotion(Path path, SpeedPlan plan, SmoothCurve ground_height_of_x_m, double body_height_m);
+  VehicleMotion(Path path, SpeedPlan plan, SmoothCurve road_height_m, double body_height_m,
+                RoadHeightOf height_of = RoadHeightOf::WorldX);
   [[nodiscard]] BodyState state(double t_s) const override;
   [[nodiscard]] const Path& path() const { return path_; }
   [[nodiscard]] const SpeedPlan& plan() const { return plan_; }
@@ -47,8 +53,9 @@ class VehicleMotion final : public MotionModel {
  private:
   Path path_;
   SpeedPlan plan_;
-  SmoothCurve ground_;
+  SmoothCurve road_;
   double body_height_m_;
+  RoadHeightOf height_of_;
 };
 
 /// How a hand-held sensor bobs and sways while walking (all tied to the distance walked, so

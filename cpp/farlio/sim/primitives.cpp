@@ -18,9 +18,10 @@ std::optional<RayHit> Box::intersect(const Eigen::Vector3d& origin, const Eigen:
                                      double max_range_m) const {
   const double c = std::cos(yaw_rad), s = std::sin(yaw_rad);
   const Eigen::Vector3d o = origin - center_m;
-  // Into the box frame: rotate by -yaw.
-  const Eigen::Vector3d lo(c * o.x() + s * o.y(), -s * o.x() + c * o.y(), o.z());
-  const Eigen::Vector3d ld(c * dir.x() + s * dir.y(), -s * dir.x() + c * dir.y(), dir.z());
+  // Into the box frame: rotate by -yaw, and shear z by the slope so the inclined faces are level.
+  const double ox = c * o.x() + s * o.y(), dx = c * dir.x() + s * dir.y();
+  const Eigen::Vector3d lo(ox, -s * o.x() + c * o.y(), o.z() - slope * ox);
+  const Eigen::Vector3d ld(dx, -s * dir.x() + c * dir.y(), dir.z() - slope * dx);
   double t_near = -kInf, t_far = kInf;
   int axis = 0;
   for (int k = 0; k < 3; ++k) {
@@ -41,6 +42,7 @@ std::optional<RayHit> Box::intersect(const Eigen::Vector3d& origin, const Eigen:
   if (t_near < kMinRange_m || t_near > max_range_m) return std::nullopt;
   Eigen::Vector3d n_local = Eigen::Vector3d::Zero();
   n_local[axis] = 1.0;
+  if (axis == 2) n_local = Eigen::Vector3d(-slope, 0.0, 1.0).normalized();
   return RayHit{t_near,
                 Eigen::Vector3d(c * n_local.x() - s * n_local.y(), s * n_local.x() + c * n_local.y(), n_local.z()),
                 reflectivity};
@@ -92,8 +94,12 @@ double surface_distance(const Vec& excess) {
 }  // namespace
 
 double Box::surface_distance_m(const Eigen::Vector3d& p) const {
-  const Eigen::Vector3d local = Eigen::AngleAxisd(-yaw_rad, Eigen::Vector3d::UnitZ()) * (p - center_m);
-  return surface_distance(Eigen::Vector3d(local.cwiseAbs() - half_extent_m));
+  Eigen::Vector3d local = Eigen::AngleAxisd(-yaw_rad, Eigen::Vector3d::UnitZ()) * (p - center_m);
+  // The inclined faces: the sheared height over the face's normal length is the distance to its plane.
+  const double incline = std::sqrt(1.0 + slope * slope);
+  local.z() = (local.z() - slope * local.x()) / incline;
+  return surface_distance(Eigen::Vector3d(
+      local.cwiseAbs() - Eigen::Vector3d(half_extent_m.x(), half_extent_m.y(), half_extent_m.z() / incline)));
 }
 
 double Cylinder::surface_distance_m(const Eigen::Vector3d& p) const {

@@ -14,18 +14,21 @@ struct RayHit {
 };
 
 /// A box with vertical sides rotated by yaw about the vertical axis (buildings, walls,
-/// barriers, parked cars, thin fences).
+/// barriers, parked cars, thin fences). With a slope its top and bottom are inclined along its
+/// own x (a ramp): in the box frame they are z = slope * x +- half_extent_m.z.
 struct Box {
   Eigen::Vector3d center_m = Eigen::Vector3d::Zero();
   Eigen::Vector3d half_extent_m = Eigen::Vector3d::Ones();  ///< along the box's own x, y, z
   double yaw_rad = 0.0;
   float reflectivity = 0.5F;
+  double slope = 0.0;  ///< rise of the top and bottom per metre along the box's x (0: level)
 
   [[nodiscard]] std::optional<RayHit> intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
                                                 double max_range_m) const;
   /// Horizontal bounding rectangle (min x, min y, max x, max y).
   [[nodiscard]] Eigen::Vector4d bounds_xy() const;
-  /// Distance from p to the box's surface (from inside or outside).
+  /// Distance from p to the box's surface (from inside or outside; with a slope, within a
+  /// factor 1 + slope^2 of it near the inclined faces' edges).
   [[nodiscard]] double surface_distance_m(const Eigen::Vector3d& p) const;
 };
 

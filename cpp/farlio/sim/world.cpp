@@ -10,6 +10,7 @@ World build_world(Profile profile) {
     case Profile::Urban: return build_urban_world();
     case Profile::Handheld: return build_handheld_world();
     case Profile::Tunnel: return build_tunnel_world();
+    case Profile::Garage: return build_garage_world();
   }
   throw std::invalid_argument("unknown profile");
 }

@@ -28,9 +28,10 @@ World build_racetrack_world();
 World build_urban_world();
 World build_handheld_world();
 World build_tunnel_world();
+World build_garage_world();
 
-/// The urban car's roof LiDAR (one 64-beam spinning sensor) and its extrinsic, into w (urban
-/// and tunnel).
+/// The urban car's roof LiDAR (one 64-beam spinning sensor) and its extrinsic, into w (urban,
+/// tunnel and garage).
 void mount_car_lidar(World& w);
 
 /// A small fixed rotation plus offset, used for the LiDAR extrinsics.
