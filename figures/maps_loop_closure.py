@@ -8,7 +8,7 @@ printing
                           with its estimate within the loop edge's std) and candidates verified
   precision               accepted loops whose registered pose (loops.csv tx..qw) is within
                           CORRECT_LOOP_M and CORRECT_LOOP_DEG of the ground truth's relative pose
-  recall                  the revisited path (scans within REVISIT_M of where the ground truth was
+  recall                  the revisited path (scans within REVISIT_M, REVISIT_HEIGHT_M of where the truth was
                           at least 2 submap lengths earlier) that lies within loop.submap_length_m
                           of an accepted loop's query keyframe
   verify s, graph s        time spent verifying candidates, and in the pose graph's updates (iSAM2)
@@ -53,7 +53,8 @@ from harness import GeneratedDataset, ape_m, config, fixed_latency, generated_da
 from scipy.spatial.transform import Rotation  # xyzw quaternions, as loops.csv
 
 CORRECT_LOOP_M, CORRECT_LOOP_DEG = 0.5, 1.0
-REVISIT_M = 5.0
+#: a revisit: within REVISIT_M horizontally and REVISIT_HEIGHT_M vertically (a garage's levels are 3.2 m apart)
+REVISIT_M, REVISIT_HEIGHT_M = 5.0, 1.5
 HANDOVER_SEPARATION_M, HANDOVER_STRIDE = (60.0, 200.0), 10
 #: the rebuilt maps' surfaces (--walls): points drawn from each map, its cells, and "far" from a surface
 WALL_POINTS, WALL_RESOLUTION_M, WALL_FAR_M = 100_000, 0.2, 0.2
@@ -91,15 +92,19 @@ def gt_lidar(gen) -> tuple[np.ndarray, list[np.ndarray]]:
 
 
 def revisited(poses: list[np.ndarray], submap_length_m: float) -> tuple[np.ndarray, np.ndarray]:
-    """The path length (m) at each true pose, and whether it lies within REVISIT_M of where the
-    truth was at least MIN_LOOP_TRAVEL_FACTOR submap lengths of path earlier."""
+    """The path length (m) at each true pose, and whether it lies within REVISIT_M horizontally and
+    REVISIT_HEIGHT_M vertically of where the truth was at least MIN_LOOP_TRAVEL_FACTOR submap lengths
+    of path earlier."""
     P = np.array([p[:3, 3] for p in poses])
     path = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(P, axis=0), axis=1))]
     min_travel = MIN_LOOP_TRAVEL_FACTOR * submap_length_m
     revisit = np.zeros(len(P), bool)
     for i in range(len(P)):
         earlier = path < path[i] - min_travel
-        revisit[i] = earlier.any() and np.min(np.linalg.norm(P[earlier] - P[i], axis=1)) < REVISIT_M
+        near = (np.linalg.norm(P[earlier, :2] - P[i, :2], axis=1) < REVISIT_M) & (
+            np.abs(P[earlier, 2] - P[i, 2]) < REVISIT_HEIGHT_M
+        )
+        revisit[i] = bool(near.any())
     return path, revisit
 
 

@@ -8,7 +8,8 @@ loop.submap_length_m of path before it. When a keyframe's segment is complete:
 
 1. candidates: earlier keyframes at least MIN_LOOP_TRAVEL_FACTOR submap lengths back along the
    path whose global position (the pose graph's current estimate) lies within loop.search_radius_m
-   plus SEARCH_DRIFT of the path between them; the nearest is verified;
+   plus SEARCH_DRIFT of the path between them, and within the height the odometry can drift over
+   that path (vertical_drift_m); the nearest is verified;
 2. verification by farlio's own GICP (register_pair), coarse to fine from the graph's guess: the
    query's submap against the candidate's (and its neighbours'), accepted only when
    - at least loop.min_overlap of the query's cells land on the candidate's map, and
@@ -17,6 +18,12 @@ loop.submap_length_m of path before it. When a keyframe's segment is complete:
      at a clearly worse fit: a straight with evenly spaced posts or two identical corridors let
      a registration lock onto the wrong copy, which fits as well, and then the starts disagree.
      A start that stalls in a local minimum (still turned, and a clearly worse fit) is no rival;
+   - the height it corrects is within what the odometry can drift over the path between the two
+     (vertical_drift_m). A parking garage's levels look alike from inside, and a query's submap
+     slides onto the level below as readily as the starts above slide along a straight; but the
+     level below is a level height away, which a gravity-aligned odometry does not drift by
+     over a few hundred metres. The ambiguity test cannot see it: the candidate's submap holds
+     its own level only;
 3. the pose graph (pose_graph.py) gets the loop edge and is optimised (iSAM2), unless the graph
    already agrees with the loop within the loop edge's standard deviations (LOOP_SIGMA).
 
@@ -57,6 +64,12 @@ SCANS_LIDAR_GLOBAL_TUM, SCANS_BODY_GLOBAL_TUM, LOOPS_CSV = (
 MIN_LOOP_TRAVEL_FACTOR = 2.0
 #: the search radius grows by this fraction of the path between query and candidate (odometry drift)
 SEARCH_DRIFT = 0.005
+#: the height a loop may correct, and a candidate's estimate differ by: VERTICAL_DRIFT_M plus
+#: VERTICAL_DRIFT of the path between query and candidate. The odometry's own height error is
+#: 0.2-0.5 m over a 4 km racetrack lap, a few metres with LiDAR only, 0.2 m RMS (0.44 m at most) in
+#: the simulator's parking garage (docs/maps.md), whose next level is 3.2 m away over 160 m of path
+#: (a ramp lap): three times the 1.1 m this allows there.
+VERTICAL_DRIFT_M, VERTICAL_DRIFT = 0.3, 0.005
 #: after a candidate refused as ambiguous, the search waits this fraction of a submap length: the
 #: next keyframes' submaps share most of its scans (a straight stays ambiguous for its length)
 RETRY_AFTER_AMBIGUOUS = 0.5
@@ -174,6 +187,11 @@ def _thinned(chunks: list[np.ndarray], cell_m: float) -> np.ndarray:
     points = np.concatenate(chunks)
     _, first = np.unique(_cell_keys(points, cell_m), return_index=True)
     return points[np.sort(first)]
+
+
+def vertical_drift_m(travel_m: float) -> float:
+    """The height the odometry can drift over travel_m of path (VERTICAL_DRIFT_M, VERTICAL_DRIFT)."""
+    return VERTICAL_DRIFT_M + VERTICAL_DRIFT * travel_m
 
 
 def _yaw_offset(dx: float, dy: float, yaw: float) -> np.ndarray:
@@ -303,7 +321,8 @@ class LoopClosure:
             if travel < MIN_LOOP_TRAVEL_FACTOR * self.submap_length_m:
                 break
             d = float(np.linalg.norm(G[k][:3, 3] - G[j][:3, 3]))
-            if d <= self.search_radius_m + SEARCH_DRIFT * travel and d < best_d:
+            level = abs(G[k][2, 3] - G[j][2, 3]) <= vertical_drift_m(travel)
+            if level and d <= self.search_radius_m + SEARCH_DRIFT * travel and d < best_d:
                 best, best_d = j, d
         if best is not None:
             self.verify(k, best, best_d)
@@ -342,6 +361,11 @@ class LoopClosure:
         guess = np.linalg.inv(self.graph.pose(j)) @ self.graph.pose(k)
         c = self.check(k, j, guess)
         T, reason = c.T, c.reason
+        travel = self.keyframes[k].path_m - self.keyframes[j].path_m
+        rise_m = float((self.graph.pose(j) @ T)[2, 3] - self.graph.pose(k)[2, 3]) if not reason else 0.0
+        if abs(rise_m) > (drift_m := vertical_drift_m(travel)):
+            reason = f"height corrected by {rise_m:.2f} m, beyond the {drift_m:.2f} m the odometry drifts"
+            reason += f" over {travel:.0f} m (another level?)"
         correction = np.linalg.inv(guess) @ T if np.all(np.isfinite(T)) else np.full((4, 4), np.nan)
         finite = bool(np.all(np.isfinite(correction)))
         correction_m = float(np.linalg.norm(correction[:3, 3]))

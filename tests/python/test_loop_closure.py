@@ -3,9 +3,10 @@
 ground truth; places that are not the same (keyframes 60-200 m apart on the racetrack's first lap
 and in the tunnel, whose walls repeat, handed over as if they were one place) are never accepted as
 a loop at a wrong pose, and the tunnel closes no loop; the global trajectory is closer to the
-ground truth than the odometry's; the live back end does the same beside the online odometry, on
-threads that yield to it; the handheld walk's return is found without moving a trajectory that
-did not drift; the CLI writes the global trajectories and loops.csv."""
+ground truth than the odometry's; in a parking garage whose levels look alike, no level is closed
+onto the one below, though the registration alone would; the live back end does the same beside
+the online odometry, on threads that yield to it; the handheld walk's return is found without
+moving a trajectory that did not drift; the CLI writes the global trajectories and loops.csv."""
 
 from __future__ import annotations
 
@@ -48,6 +49,12 @@ REVISIT_M = 5.0
 MIN_CLOSED_SHARE = 0.8
 #: the tunnel from its standing start to ~560 m along it
 TUNNEL_DURATION_S = 30.0
+#: the garage from its standing start up the first ramp and around level 1, over level 0
+GARAGE_DURATION_S = 60.0
+#: a keyframe over another: within ABOVE_M horizontally and more than ABOVE_HEIGHT_M higher (a level: 3.2 m)
+ABOVE_M, ABOVE_HEIGHT_M = 5.0, 3.0
+#: a registration on the wrong level: this far (m) from the true relative pose
+WRONG_LEVEL_M = 2.0
 
 
 def loop_run(profile: str, duration_s: float, **sim):
@@ -114,6 +121,12 @@ def tunnel():
     return loop_run("tunnel", TUNNEL_DURATION_S)
 
 
+@pytest.fixture(scope="module")
+def garage():
+    """The garage's levels 0 and 1: identical pillars, parked cars, walls and ramps."""
+    return loop_run("garage", GARAGE_DURATION_S)
+
+
 def _off(T_est: np.ndarray, T_true: np.ndarray) -> tuple[float, float]:
     d = _core.SE3.from_matrix(np.linalg.inv(T_true) @ T_est)
     return float(np.linalg.norm(d.translation)), math.degrees(d.angle_rad())
@@ -169,6 +182,41 @@ def test_different_places_are_never_a_loop_at_a_wrong_pose(scene, request):
             break
     assert checked >= 3
     assert accepted_wrong == 0
+
+
+def test_a_garage_level_is_never_closed_onto_the_level_below(garage):
+    """Every keyframe of level 1 that lies over a keyframe of level 0 (at least two submap lengths
+    back): the search never proposes the pair (the estimate's heights differ by a level, beyond what
+    the odometry drifts), and verified anyway from the graph's guess it is refused. Without that
+    height check the pair would pass: the query's submap slides down onto the identical level below,
+    overlapping it fully, and the ambiguity test's horizontal starts all come back to it."""
+    loops, _, _, gt_lidar, _ = garage
+    assert not loops.records  # nothing revisited on the same level
+    kfs = loops.keyframes
+    true_at = [gt_lidar(kf.stamp_ns) for kf in kfs]
+    pairs = []
+    for k in range(len(kfs)):
+        below = [
+            j
+            for j in range(k)
+            if kfs[k].path_m - kfs[j].path_m >= MIN_LOOP_TRAVEL_FACTOR * loops.submap_length_m
+            and np.linalg.norm(true_at[k][:2, 3] - true_at[j][:2, 3]) < ABOVE_M
+            and true_at[k][2, 3] - true_at[j][2, 3] > ABOVE_HEIGHT_M
+        ]
+        if below:
+            pairs.append((k, below[-1]))
+    assert len(pairs) >= 5
+    slid = 0
+    for k, j in pairs:
+        true = np.linalg.inv(true_at[j]) @ true_at[k]
+        guess = np.linalg.inv(loops.graph.pose(j)) @ loops.graph.pose(k)
+        c = loops.check(k, j, guess)
+        slid += int(not c.reason and _off(c.T, true)[0] > WRONG_LEVEL_M)
+        loops.verify(k, j, float(np.linalg.norm(guess[:3, 3])))
+        r = loops.records[-1]
+        assert not r.accepted, (k, j, r)
+    print(f"{slid} of {len(pairs)} level-1 keyframes pass the registration's checks on the level below")
+    assert slid >= 2
 
 
 def test_the_global_trajectory_is_closer_to_the_ground_truth(lap):
