@@ -21,9 +21,9 @@ loop.submap_length_m of path before it. When a keyframe's segment is complete:
    - the height it corrects is within what the odometry can drift over the path between the two
      (vertical_drift_m). A parking garage's levels look alike from inside, and a query's submap
      slides onto the level below as readily as the starts above slide along a straight; but the
-     level below is a level height away, which a gravity-aligned odometry does not drift by
-     over a few hundred metres. The ambiguity test cannot see it: the candidate's submap holds
-     its own level only;
+     level below is a level height away, which the odometry does not drift by over a few
+     hundred metres. The ambiguity test cannot see it: the candidate's submap holds its own
+     level only;
 3. the pose graph (pose_graph.py) gets the loop edge and is optimised (iSAM2), unless the graph
    already agrees with the loop within the loop edge's standard deviations (LOOP_SIGMA).
 
