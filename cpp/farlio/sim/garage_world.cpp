@@ -46,13 +46,6 @@ constexpr double kGridCell_m = 8.0;
 
 double level_z(int level) { return kLevelHeight_m * level; }
 
-/// The axis-aligned box [x0, x1] x [y0, y1] x [z0, z1].
-void add_block(Scene& scene, double x0, double x1, double y0, double y1, double z0, double z1, float reflectivity) {
-  scene.add(Box{Eigen::Vector3d(0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.5 * (z0 + z1)),
-                Eigen::Vector3d(0.5 * std::abs(x1 - x0), 0.5 * std::abs(y1 - y0), 0.5 * std::abs(z1 - z0)), 0.0,
-                reflectivity});
-}
-
 /// The slab whose top is level `level`'s floor; below the roof it has the ramp lane's opening.
 void add_slab(Scene& scene, int level) {
   const double z1 = level_z(level), z0 = z1 - kSlabThickness_m;

@@ -47,13 +47,6 @@ constexpr float kGroundReflectivity = 0.25F;
 constexpr double kGridCell_m = 10.0;
 constexpr int kBisectionSteps = 60;
 
-/// The axis-aligned box [x0, x1] x [y0, y1] x [z0, z1] (corners in any order).
-void add_block(Scene& scene, double x0, double x1, double y0, double y1, double z0, double z1, float reflectivity) {
-  scene.add(Box{Eigen::Vector3d(0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.5 * (z0 + z1)),
-                Eigen::Vector3d(0.5 * std::abs(x1 - x0), 0.5 * std::abs(y1 - y0), 0.5 * std::abs(z1 - z0)), 0.0,
-                reflectivity});
-}
-
 /// Niche start positions along one wall: random spacing within [begin, end - length].
 std::vector<double> niche_starts(double begin_m, double end_m, Rng& rng) {
   std::vector<double> xs;

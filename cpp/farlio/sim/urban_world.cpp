@@ -63,8 +63,7 @@ void add_box_on_ground(Scene& scene, const GroundProfile& g, double x0, double y
                        double height_m, float reflectivity) {
   const double z_lo = std::min(g.height_m(x0), g.height_m(x1)) - kFoundationDepth_m;
   const double z_hi = std::max(g.height_m(x0), g.height_m(x1)) + height_m;
-  scene.add(Box{Eigen::Vector3d(0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.5 * (z_lo + z_hi)),
-                Eigen::Vector3d(0.5 * (x1 - x0), 0.5 * (y1 - y0), 0.5 * (z_hi - z_lo)), 0.0, reflectivity});
+  add_block(scene, x0, x1, y0, y1, z_lo, z_hi, reflectivity);
 }
 
 void add_blocks(Scene& scene, const GroundProfile& g, Rng& rng) {

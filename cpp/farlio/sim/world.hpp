@@ -34,6 +34,9 @@ World build_garage_world();
 /// tunnel and garage).
 void mount_car_lidar(World& w);
 
+/// The level, axis-aligned box [x0, x1] x [y0, y1] x [z0, z1] (corners in any order), into scene.
+void add_block(Scene& scene, double x0, double x1, double y0, double y1, double z0, double z1, float reflectivity);
+
 /// A small fixed rotation plus offset, used for the LiDAR extrinsics.
 SE3 mount_pose(const Eigen::Vector3d& offset_m, double yaw_rad, double pitch_rad, double roll_rad);
 
