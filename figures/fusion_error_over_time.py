@@ -1,6 +1,7 @@
 """Where along a run and along which axis the error is: the scan poses of a run against the ground
 truth, aligned as `farlio eval` aligns them (the project's evaluation), with the RMS error per second
-and per axis of the ground truth's frame, and the error along one axis every `--every` seconds.
+and per axis of the ground truth's frame, and the error along one axis every `--every` seconds; with
+`--origin`, aligned at the first pose only (the drift from the start, a constant tilt included).
 docs/fusion.md, "Other LiDARs" (the Mid-360 urban cut's 7 cm step along the track at 6.0-6.5 s):
 
   farlio simulate urban --lidar mid360 --start 10 --duration 10 --seed 1 --out cut
@@ -15,14 +16,16 @@ from pathlib import Path
 
 import numpy as np
 from farlio import _core
+from farlio.evaluation import make_options
 
 NS_PER_S = 1e9
 
 
-def errors(groundtruth: Path, estimate: Path) -> tuple[np.ndarray, np.ndarray]:
+def errors(groundtruth: Path, estimate: Path, origin: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """Seconds since the first associated pose and the aligned position errors (N x 3, m)."""
     read = _core.io.read_trajectory
-    result = _core.eval.evaluate(read(estimate, "tum", None), read(groundtruth, "tum", None))
+    options = make_options(align_origin=origin)
+    result = _core.eval.evaluate(read(estimate, "tum", None), read(groundtruth, "tum", None), options)
     stamps = np.asarray(result.stamps_ns, dtype=np.float64)
     diff = np.asarray(result.ape.aligned_positions_m) - np.asarray(result.groundtruth_positions_m)
     return (stamps - stamps[0]) / NS_PER_S, diff
@@ -45,9 +48,10 @@ def main() -> None:
     ap.add_argument("estimates", type=Path, nargs="+", help="TUM files of runs (scans_body.tum)")
     ap.add_argument("--axis", choices="xyz", default="x", help="the axis of the ground truth's frame to follow")
     ap.add_argument("--every", type=float, default=0.5, help="seconds between the printed errors along it")
+    ap.add_argument("--origin", action="store_true", help="align at the first pose only, not over the whole run")
     args = ap.parse_args()
     for estimate in args.estimates:
-        t, diff = errors(args.groundtruth, estimate)
+        t, diff = errors(args.groundtruth, estimate, args.origin)
         report(str(estimate), t, diff, "xyz".index(args.axis), args.every)
 
 
