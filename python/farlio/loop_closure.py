@@ -66,7 +66,7 @@ MIN_LOOP_TRAVEL_FACTOR = 2.0
 SEARCH_DRIFT = 0.005
 #: the height a loop may correct, and a candidate's estimate differ by: VERTICAL_DRIFT_M plus
 #: VERTICAL_DRIFT of the path between query and candidate. The odometry's own height error is
-#: 0.2-0.5 m over a 4 km racetrack lap, a few metres with LiDAR only, 0.2 m RMS (0.44 m at most) in
+#: 0.5-4 m RMS over the racetrack's two laps (8.3 km; 20 m allowed per 4 km lap) and 0.2 m RMS in
 #: the simulator's parking garage (docs/maps.md), whose next level is 3.2 m away over 160 m of path
 #: (a ramp lap): three times the 1.1 m this allows there.
 VERTICAL_DRIFT_M, VERTICAL_DRIFT = 0.3, 0.005
